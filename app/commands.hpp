@@ -1,0 +1,22 @@
+// The deformlab subcommands. Each returns the process exit code: 0 success, 1 a run that
+// failed (divergence, a backend error), 2 bad input (nothing written).
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace deformlab::app {
+
+struct RunArgs {
+  std::vector<std::string> argv;  // the whole command, for the manifest
+  std::optional<std::string> experiment, scene, pipeline, integrator, grid, lattice, compare;
+  std::optional<int> steps, check_every;
+  std::optional<double> dt, threshold;
+  bool until_converged = false;
+  std::optional<std::string> out;
+};
+
+int run_command(const RunArgs& a);
+int list_command();
+
+}  // namespace deformlab::app

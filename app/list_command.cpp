@@ -1,0 +1,32 @@
+#include <iomanip>
+#include <iostream>
+
+#include "commands.hpp"
+#include "core/integrator.hpp"
+#include "experiments/pipelines.hpp"
+
+namespace deformlab::app {
+
+int list_command() {
+  std::cout << "Pipelines (in order of expected speed; 'best' picks the first available):\n";
+  for (const auto& e : pipelines().all()) {
+    const std::string why = e.unavailable();
+    std::cout << "  " << std::left << std::setw(15) << e.name << (why.empty() ? "available    " : "unavailable  ")
+              << e.summary << (e.deterministic ? "" : " [not bitwise deterministic]") << "\n";
+    if (!why.empty()) {
+      std::cout << "  " << std::setw(15) << "" << "  why: " << why << "\n";
+      continue;
+    }
+    for (const auto& i : integrators())
+      if (const auto no = e.unsupported(i.id); !no.empty())
+        std::cout << "  " << std::setw(15) << "" << "  no " << i.name << ": " << no << "\n";
+  }
+  std::cout << "\nIntegrators (name, paper's name, force passes per step, order):\n";
+  for (const auto& i : integrators())
+    std::cout << "  " << std::left << std::setw(21) << i.name << std::setw(18)
+              << (i.paper_alias.empty() ? "-" : std::string(i.paper_alias)) << i.force_passes << "  " << i.order
+              << "  " << i.summary << "\n";
+  return 0;
+}
+
+}  // namespace deformlab::app

@@ -1,0 +1,44 @@
+// deformlab: GPU mass-spring deformation pipelines, measured against a CPU reference.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  using deformlab::app::RunArgs;
+  CLI::App cli{"deformlab: mass-spring deformation on CPU, CUDA and GLSL pipelines"};
+  cli.require_subcommand(1);
+  RunArgs a;
+  for (int i = 0; i < argc; ++i) a.argv.emplace_back(argv[i]);
+
+  auto* run = cli.add_subcommand("run", "Run an experiment (with no options: the paper's drag experiment)");
+  run->add_option("--experiment", a.experiment, "Experiment file (default: the built-in paper-drag)");
+  run->add_option("--scene", a.scene, "Scene file overriding the experiment's scene");
+  run->add_option("--pipeline,-p", a.pipeline, "Pipeline name ('deformlab list'), or 'best'");
+  run->add_option("--integrator,-i", a.integrator, "Integrator name ('deformlab list')");
+  auto* grid = run->add_option("--grid", a.grid, "Cloth grid size WxH, e.g. 128x128");
+  run->add_option("--lattice", a.lattice, "Lattice size WxHxD, e.g. 8x8x8")->excludes(grid);
+  run->add_option("--steps", a.steps, "Number of steps (with --until-converged: the most steps)");
+  run->add_flag("--until-converged", a.until_converged, "Stop once no node moves more than the threshold in a step");
+  run->add_option("--dt", a.dt, "Time step, s");
+  run->add_option("--threshold", a.threshold, "Convergence threshold, m per step");
+  run->add_option("--check-every", a.check_every, "Steps between convergence and divergence checks");
+  run->add_option("--compare", a.compare, "Also run the double-precision reference ('cpu') and report the error");
+  run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
+
+  auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");
+
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "deformlab: error: " << e.what() << " (see deformlab --help)\n";
+    return 2;
+  }
+  if (*run) return deformlab::app::run_command(a);
+  if (*list) return deformlab::app::list_command();
+  return 2;
+}

@@ -1,0 +1,320 @@
+#include "cpu_backend.hpp"
+
+#include <omp.h>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCore>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "forces.hpp"
+
+namespace deformlab {
+namespace {
+
+template <class Real>
+class CpuPipeline final : public Pipeline {
+  using V = Vec3<Real>;
+  struct Slot {
+    std::vector<V> x, v;
+  };
+
+ public:
+  CpuPipeline(const PipelineSetup& s, bool parallel)
+      : m_(s.model), p_(s.params), sched_(make_schedule(s.integrator)), parallel_(parallel) {
+    const std::size_t n = m_.rest_position.size();
+    slots_.resize(1 + sched_.stage_states);
+    for (auto& sl : slots_) { sl.x.resize(n); sl.v.resize(n); }
+    acc_.resize(sched_.accel_slots, std::vector<V>(n));
+    next_.x.resize(n); next_.v.resize(n);
+    set_state(rest_state(m_));
+  }
+
+  void set_state(const State& s) override {
+    const std::size_t n = m_.rest_position.size();
+    if (s.x.size() != n || s.v.size() != n || (!s.x_prev.empty() && s.x_prev.size() != n))
+      throw std::invalid_argument("state size does not match the model");
+    for (std::size_t i = 0; i < n; ++i) {
+      slots_[0].x[i] = V(s.x[i]);
+      slots_[0].v[i] = V(s.v[i]);
+    }
+    has_prev_ = !s.x_prev.empty();
+    x_prev_.resize(n);
+    if (has_prev_)
+      for (std::size_t i = 0; i < n; ++i) x_prev_[i] = V(s.x_prev[i]);
+    t_ = s.t;
+    last_disp_ = 0.0;
+  }
+
+  State state() override {
+    State s;
+    s.t = t_;
+    const std::size_t n = slots_[0].x.size();
+    s.x.resize(n); s.v.resize(n);
+    for (std::size_t i = 0; i < n; ++i) { s.x[i] = Vec3f(slots_[0].x[i]); s.v[i] = Vec3f(slots_[0].v[i]); }
+    if (has_prev_) {
+      s.x_prev.resize(n);
+      for (std::size_t i = 0; i < n; ++i) s.x_prev[i] = Vec3f(x_prev_[i]);
+    }
+    return s;
+  }
+
+  void step() override {
+    for (const Pass& pass : sched_.passes) {
+      switch (pass.op) {
+        case Pass::Op::force: force(slots_[pass.src], acc_[pass.acc], t_ + pass.time_fraction * p_.dt); break;
+        case Pass::Op::stage: stage(pass); break;
+        case Pass::Op::combine: combine(pass); break;
+        case Pass::Op::fused: fused(); break;
+        case Pass::Op::solve: solve(); break;
+      }
+    }
+    constrain_and_commit();
+  }
+
+  double max_displacement() override { return last_disp_; }
+
+ private:
+  bool hard_drag(int i) const { return p_.drag.active() && !p_.drag.as_spring && i == p_.drag.node; }
+
+  template <class F>
+  void for_nodes(F&& f) {
+    const int n = m_.node_count();
+#pragma omp parallel for schedule(static) if (parallel_)
+    for (int i = 0; i < n; ++i) f(i);
+  }
+
+  void force(const Slot& s, std::vector<V>& a, double t) {
+    const V g(p_.gravity), wind(p_.wind);
+    const Real c = p_.damping;
+    const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
+    const V target = spring_drag ? V(p_.drag.target(t)) : V{};
+    for_nodes([&](int i) {
+      const Real w = m_.inv_mass[i];
+      if (w == Real(0) || hard_drag(i)) { a[i] = V{}; return; }
+      V f{};
+      for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
+        const int sp = m_.adj_spring[e], j = m_.adj_node[e];
+        const int k = int(m_.kind[sp]);
+        f += spring_force(s.x[i], s.x[j], s.v[i], s.v[j], Real(m_.stiffness[k]), Real(m_.damping[k]),
+                          Real(m_.rest_length[sp]));
+      }
+      if (spring_drag && i == p_.drag.node) f += (target - s.x[i]) * Real(p_.drag.stiffness);
+      a[i] = acceleration(f, s.v[i], w, c, wind, g);
+    });
+  }
+
+  void stage(const Pass& pass) {
+    const Real h = Real(pass.coef * p_.dt);
+    const Slot &s0 = slots_[0], &src = slots_[pass.src];
+    Slot& dst = slots_[pass.dst];
+    const auto& a = acc_[pass.acc];
+    for_nodes([&](int i) {
+      dst.x[i] = s0.x[i] + src.v[i] * h;
+      dst.v[i] = s0.v[i] + a[i] * h;
+    });
+  }
+
+  void combine(const Pass& pass) {
+    const Real dt = p_.dt;
+    const Slot& s0 = slots_[0];
+    const int terms = int(pass.weights.size());
+    for_nodes([&](int i) {
+      V dx{}, dv{};
+      for (int k = 0; k < terms; ++k) {
+        if (pass.weights[k] == 0.0) continue;
+        const Real w = Real(pass.weights[k]);
+        dx += slots_[k].v[i] * w;
+        dv += acc_[k][i] * w;
+      }
+      next_.x[i] = s0.x[i] + dx * dt;
+      next_.v[i] = s0.v[i] + dv * dt;
+    });
+  }
+
+  void fused() {
+    const Real dt = p_.dt;
+    const Slot& s = slots_[0];
+    const auto& a = acc_[0];
+    switch (sched_.integrator) {
+      case Integrator::explicit_euler:
+        for_nodes([&](int i) {
+          next_.x[i] = s.x[i] + s.v[i] * dt;
+          next_.v[i] = s.v[i] + a[i] * dt;
+        });
+        break;
+      case Integrator::semi_implicit_euler:
+        for_nodes([&](int i) {
+          next_.v[i] = s.v[i] + a[i] * dt;
+          next_.x[i] = s.x[i] + next_.v[i] * dt;
+        });
+        break;
+      case Integrator::verlet:
+        for_nodes([&](int i) {
+          const V step = has_prev_ ? (s.x[i] - x_prev_[i]) + a[i] * (dt * dt)
+                                   : s.v[i] * dt + a[i] * (Real(0.5) * dt * dt);
+          next_.x[i] = s.x[i] + step;
+          next_.v[i] = step * (Real(1) / dt);
+        });
+        break;
+      default: throw std::logic_error("fused update for a multi-pass integrator");
+    }
+  }
+
+  // Backward Euler, linearised once per step (Baraff & Witkin 1998):
+  //   (M - dt D - dt^2 K) dv = dt (f0 + dt K v0),  v' = v0 + dv,  x' = x0 + dt v'
+  // with K = df/dx (the (1 - l/|d|) term clamped at 0 so K stays negative semi-definite)
+  // and D = df/dv. Pinned and hard-dragged nodes keep dv = 0 (identity rows).
+  void solve() {
+    using SpMat = Eigen::SparseMatrix<Real>;
+    using Vec = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
+    using M3 = Eigen::Matrix<Real, 3, 3>;
+    using E3 = Eigen::Matrix<Real, 3, 1>;
+    const int n = m_.node_count();
+    const Real dt = p_.dt, c = p_.damping;
+    const Slot& s = slots_[0];
+    force(s, acc_[0], t_);
+    auto fixed = [&](int i) { return m_.inv_mass[i] == 0.f || hard_drag(i); };
+    auto e3 = [](const V& v) { return E3(v.x, v.y, v.z); };
+
+    std::vector<Eigen::Triplet<Real>> trip;
+    trip.reserve(9 * (std::size_t(n) + 2 * m_.spring_count()));
+    Vec rhs(3 * n);
+    std::vector<M3> diag(n, M3::Zero());
+    std::vector<E3> kv(n, E3::Zero());  // K v0
+    auto add_block = [&](int r, int col, const M3& b) {
+      for (int a = 0; a < 3; ++a)
+        for (int q = 0; q < 3; ++q) trip.emplace_back(3 * r + a, 3 * col + q, b(a, q));
+    };
+    for (int e = 0; e < m_.spring_count(); ++e) {
+      const int i = m_.spring_i[e], j = m_.spring_j[e];
+      const int k = int(m_.kind[e]);
+      const E3 d = e3(s.x[i] - s.x[j]);
+      const Real len = d.norm();
+      if (len == Real(0)) continue;
+      const E3 u = d / len;
+      const M3 uu = u * u.transpose();
+      const Real ks = m_.stiffness[k], kd = m_.damping[k], rest = m_.rest_length[e];
+      const Real geo = std::max(Real(0), Real(1) - rest / len);
+      const M3 K = -ks * (geo * (M3::Identity() - uu) + uu);  // df_i/dx_i
+      const M3 D = -kd * uu;                                  // df_i/dv_i
+      const M3 A = -dt * D - dt * dt * K;                      // contribution to A_ii (and -A_ij)
+      const E3 vi = e3(s.v[i]), vj = e3(s.v[j]);
+      kv[i] += K * (vi - vj);
+      kv[j] += K * (vj - vi);
+      diag[i] += A;
+      diag[j] += A;
+      if (!fixed(i) && !fixed(j)) {
+        add_block(i, j, -A);
+        add_block(j, i, -A);
+      }
+    }
+    const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
+    for (int i = 0; i < n; ++i) {
+      if (fixed(i)) {
+        add_block(i, i, M3::Identity());
+        rhs.template segment<3>(3 * i).setZero();
+        continue;
+      }
+      const Real mass = Real(1) / Real(m_.inv_mass[i]);
+      M3 b = diag[i] + (mass + dt * c) * M3::Identity();
+      E3 k_v = kv[i];
+      if (spring_drag && i == p_.drag.node) {
+        b += dt * dt * Real(p_.drag.stiffness) * M3::Identity();
+        k_v -= Real(p_.drag.stiffness) * e3(s.v[i]);
+      }
+      add_block(i, i, b);
+      const E3 f0 = mass * e3(acc_[0][i]);  // the force pass already holds f0 / m
+      rhs.template segment<3>(3 * i) = dt * (f0 + dt * k_v);
+    }
+    SpMat A(3 * n, 3 * n);
+    A.setFromTriplets(trip.begin(), trip.end());
+    Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper> cg;
+    cg.setTolerance(std::is_same_v<Real, double> ? Real(1e-10) : Real(1e-6));
+    cg.setMaxIterations(std::max(100, 3 * n));
+    cg.compute(A);
+    const Vec dv = cg.solve(rhs);
+    if (cg.info() != Eigen::Success && !(cg.error() < 1e-3))
+      throw std::runtime_error("backward Euler: conjugate gradient did not converge (error " +
+                               std::to_string(double(cg.error())) + ")");
+    for (int i = 0; i < n; ++i) {
+      next_.v[i] = s.v[i] + V{dv(3 * i), dv(3 * i + 1), dv(3 * i + 2)};
+      next_.x[i] = s.x[i] + next_.v[i] * dt;
+    }
+  }
+
+  // Constraints on next_, then next_ becomes the current state; records the largest
+  // displacement of the step (NaN if any value is not finite).
+  void constrain_and_commit() {
+    const Real dt = p_.dt;
+    const double t1 = t_ + p_.dt;
+    const V drag_target = p_.drag.active() ? V(p_.drag.target(t1)) : V{};
+    const Real ground = p_.ground ? Real(*p_.ground) : Real(0);
+    Slot& s = slots_[0];
+    double disp = 0.0;
+    bool finite = true;
+    const int n = m_.node_count();
+#pragma omp parallel for schedule(static) if (parallel_) reduction(max : disp) reduction(&& : finite)
+    for (int i = 0; i < n; ++i) {
+      V& x = next_.x[i];
+      V& v = next_.v[i];
+      if (m_.inv_mass[i] == 0.f) {
+        x = s.x[i];
+        v = V{};
+      } else if (hard_drag(i)) {
+        x = drag_target;
+        v = (x - s.x[i]) * (Real(1) / dt);
+      } else {
+        if (p_.ground) ground_constraint(x, v, ground);
+        for (const auto& sph : p_.spheres) sphere_constraint(x, v, V(sph.center), Real(sph.radius));
+      }
+      const double d = double(norm(x - s.x[i]));
+      finite = finite && std::isfinite(d) && std::isfinite(double(v.x)) && std::isfinite(double(v.y)) &&
+               std::isfinite(double(v.z));
+      disp = std::max(disp, d);
+    }
+    if (sched_.integrator == Integrator::verlet) {
+      x_prev_.swap(s.x);  // the old current positions become the previous ones
+      has_prev_ = true;
+    }
+    std::swap(s.x, next_.x);
+    std::swap(s.v, next_.v);
+    t_ = t1;
+    last_disp_ = finite ? disp : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  const Model& m_;
+  Params p_;
+  Schedule sched_;
+  bool parallel_;
+  std::vector<Slot> slots_;  // 0: current state, 1..: stage states
+  std::vector<std::vector<V>> acc_;
+  Slot next_;
+  std::vector<V> x_prev_;
+  bool has_prev_ = false;
+  double t_ = 0.0;
+  double last_disp_ = 0.0;
+};
+
+}  // namespace
+
+std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p, bool parallel) {
+  if (p == Precision::f64) return std::make_unique<CpuPipeline<double>>(s, parallel);
+  return std::make_unique<CpuPipeline<float>>(s, parallel);
+}
+
+void add_cpu_pipelines(PipelineRegistry& r) {
+  auto always = [] { return std::string(); };
+  auto every = [](Integrator) { return std::string(); };
+  r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", true, always, every,
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }});
+  r.add({"omp", "OpenMP float, " + std::to_string(omp_get_max_threads()) +
+                    " threads (the paper's optimised CPU); bitwise equal to cpu",
+         true, always, every,
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }});
+  r.add({"reference", "OpenMP double: the reference for tests and --compare", true, always, every,
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }});
+}
+
+}  // namespace deformlab

@@ -1,0 +1,188 @@
+#include "model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace deformlab {
+
+const char* to_string(SpringKind k) {
+  switch (k) {
+    case SpringKind::structural: return "structural";
+    case SpringKind::shear: return "shear";
+    case SpringKind::flexion: return "flexion";
+  }
+  return "?";
+}
+
+void Model::build_adjacency() {
+  const int n = node_count(), s = spring_count();
+  adj_offset.assign(n + 1, 0);
+  for (int e = 0; e < s; ++e) {
+    ++adj_offset[spring_i[e] + 1];
+    ++adj_offset[spring_j[e] + 1];
+  }
+  for (int v = 0; v < n; ++v) adj_offset[v + 1] += adj_offset[v];
+  adj_spring.assign(2 * std::size_t(s), 0);
+  adj_node.assign(2 * std::size_t(s), 0);
+  std::vector<std::int32_t> fill(adj_offset.begin(), adj_offset.end() - 1);
+  for (int e = 0; e < s; ++e) {
+    const int a = spring_i[e], b = spring_j[e];
+    adj_spring[fill[a]] = e; adj_node[fill[a]++] = b;
+    adj_spring[fill[b]] = e; adj_node[fill[b]++] = a;
+  }
+}
+
+float Model::extent() const {
+  if (rest_position.empty()) return 0.f;
+  Vec3f lo = rest_position[0], hi = rest_position[0];
+  for (const auto& p : rest_position)
+    for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+  return norm(hi - lo);
+}
+
+namespace {
+
+struct Offset { int di, dj, dk; SpringKind kind; };
+
+// Half of each neighbour stencil (the other half is the same springs seen from the far end).
+std::vector<Offset> half_stencil(bool volume) {
+  std::vector<Offset> o;
+  const int kmax = volume ? 1 : 0;
+  for (int dk = -kmax; dk <= kmax; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        // keep offsets that are lexicographically positive in (dk, dj, di)
+        if (dk < 0 || (dk == 0 && (dj < 0 || (dj == 0 && di <= 0)))) continue;
+        const int nonzero = (di != 0) + (dj != 0) + (dk != 0);
+        o.push_back({di, dj, dk, nonzero == 1 ? SpringKind::structural : SpringKind::shear});
+      }
+  o.push_back({2, 0, 0, SpringKind::flexion});
+  o.push_back({0, 2, 0, SpringKind::flexion});
+  if (volume) o.push_back({0, 0, 2, SpringKind::flexion});
+  return o;
+}
+
+// Grid builders index node (i, j, k) as (k*ny + j)*nx + i with axes mapped by `pos`.
+template <class PosFn>
+Model build_grid(Topology t, int nx, int ny, int nz, float h, const Material& mat, PosFn pos) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("grid dimensions must be positive");
+  if (!(h > 0.f) || !std::isfinite(h)) throw std::invalid_argument("grid spacing must be positive");
+  if (!(mat.node_mass > 0.f) || !std::isfinite(mat.node_mass))
+    throw std::invalid_argument("node mass must be positive");
+  Model m;
+  m.topology = t;
+  m.nx = nx; m.ny = ny; m.nz = nz;
+  m.spacing = h;
+  m.stiffness = mat.stiffness;
+  m.damping = mat.damping;
+  const std::size_t n = std::size_t(nx) * ny * nz;
+  m.rest_position.resize(n);
+  m.inv_mass.assign(n, 1.f / mat.node_mass);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) m.rest_position[(std::size_t(k) * ny + j) * nx + i] = pos(i, j, k);
+
+  const auto stencil = half_stencil(nz > 1 || t == Topology::lattice);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        for (const auto& o : stencil) {
+          const int a = i + o.di, b = j + o.dj, c = k + o.dk;
+          if (a < 0 || a >= nx || b < 0 || b >= ny || c < 0 || c >= nz) continue;
+          const int u = (k * ny + j) * nx + i, v = (c * ny + b) * nx + a;
+          m.spring_i.push_back(std::min(u, v));
+          m.spring_j.push_back(std::max(u, v));
+          m.kind.push_back(o.kind);
+          const Vec3d d = Vec3d(m.rest_position[u]) - Vec3d(m.rest_position[v]);
+          m.rest_length.push_back(float(norm(d)));
+        }
+  m.build_adjacency();
+  return m;
+}
+
+void check_size(std::int64_t nodes) {
+  if (nodes > std::int64_t(1) << 30)
+    throw std::invalid_argument("model of " + std::to_string(nodes) +
+                                " nodes exceeds the limit of 2^30 nodes");
+}
+
+}  // namespace
+
+Model cloth_grid(int nx, int ny, float h, float y0, const Material& mat) {
+  if (nx >= 1 && ny >= 1) check_size(std::int64_t(nx) * ny);
+  const float cx = 0.5f * float(nx - 1) * h, cz = 0.5f * float(ny - 1) * h;
+  return build_grid(Topology::cloth_grid, nx, ny, 1, h, mat, [&](int i, int j, int) {
+    return Vec3f{float(i) * h - cx, y0, float(j) * h - cz};
+  });
+}
+
+Model lattice(int nx, int ny, int nz, float h, float y0, const Material& mat) {
+  if (nx >= 1 && ny >= 1 && nz >= 1) check_size(std::int64_t(nx) * ny * nz);
+  const float cx = 0.5f * float(nx - 1) * h, cz = 0.5f * float(nz - 1) * h;
+  return build_grid(Topology::lattice, nx, ny, nz, h, mat, [&](int i, int j, int k) {
+    return Vec3f{float(i) * h - cx, y0 + float(j) * h, float(k) * h - cz};
+  });
+}
+
+std::array<std::int64_t, kSpringKinds> cloth_spring_counts(std::int64_t nx, std::int64_t ny) {
+  auto p = [](std::int64_t v) { return std::max<std::int64_t>(v, 0); };
+  return {p(nx - 1) * ny + nx * p(ny - 1), 2 * p(nx - 1) * p(ny - 1),
+          p(nx - 2) * ny + nx * p(ny - 2)};
+}
+
+std::array<std::int64_t, kSpringKinds> lattice_spring_counts(std::int64_t nx, std::int64_t ny,
+                                                             std::int64_t nz) {
+  auto p = [](std::int64_t v) { return std::max<std::int64_t>(v, 0); };
+  const std::int64_t structural = p(nx - 1) * ny * nz + nx * p(ny - 1) * nz + nx * ny * p(nz - 1);
+  const std::int64_t face = 2 * (p(nx - 1) * p(ny - 1) * nz + p(nx - 1) * ny * p(nz - 1) +
+                                 nx * p(ny - 1) * p(nz - 1));
+  const std::int64_t body = 4 * p(nx - 1) * p(ny - 1) * p(nz - 1);
+  const std::int64_t flexion = p(nx - 2) * ny * nz + nx * p(ny - 2) * nz + nx * ny * p(nz - 2);
+  return {structural, face + body, flexion};
+}
+
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& explicit_nodes) {
+  std::vector<int> out;
+  const bool grid = m.topology != Topology::general;
+  // "top": cloth row j = 0; lattice layer j = ny-1 (front row k = 0 for corners / row).
+  const int top_j = m.topology == Topology::lattice ? m.ny - 1 : 0;
+  auto node = [&](int i, int j, int k) { return (k * m.ny + j) * m.nx + i; };
+  switch (set) {
+    case PinSet::none: break;
+    case PinSet::top_corners:
+      if (!grid) throw std::invalid_argument("pin set 'top-corners' needs a grid or lattice");
+      out.push_back(node(0, top_j, 0));
+      if (m.nx > 1) out.push_back(node(m.nx - 1, top_j, 0));
+      break;
+    case PinSet::top_row:
+      if (!grid) throw std::invalid_argument("pin set 'top-row' needs a grid or lattice");
+      for (int i = 0; i < m.nx; ++i) out.push_back(node(i, top_j, 0));
+      break;
+    case PinSet::list:
+      for (int v : explicit_nodes) {
+        if (v < 0 || v >= m.node_count())
+          throw std::invalid_argument("pinned node " + std::to_string(v) + " is outside the model (0.." +
+                                      std::to_string(m.node_count() - 1) + ")");
+        out.push_back(v);
+      }
+      break;
+  }
+  return out;
+}
+
+void pin(Model& m, const std::vector<int>& nodes) {
+  for (int v : nodes) m.inv_mass.at(v) = 0.f;
+}
+
+std::int64_t model_bytes(std::int64_t nodes, std::int64_t springs) {
+  // rest pos + inv mass + adjacency offsets; spring arrays + 2 adjacency entries per spring;
+  // plus the working state of the worst integrator (RK4: 4 stage states + 4 accelerations,
+  // double-precision reference included) at 8 vec3 of doubles per stage.
+  const std::int64_t model = nodes * (12 + 4 + 4) + springs * (4 + 4 + 4 + 1 + 8 + 8);
+  const std::int64_t state = nodes * 24 * 3 * 10;
+  return model + state;
+}
+
+}  // namespace deformlab

@@ -1,0 +1,74 @@
+// Model: everything that does not change during a run (cf. MuJoCo's mjModel).
+// Sizes: n = node_count(), s = spring_count().
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vec3.hpp"
+
+namespace deformlab {
+
+enum class SpringKind : std::uint8_t { structural = 0, shear = 1, flexion = 2 };
+inline constexpr int kSpringKinds = 3;
+const char* to_string(SpringKind k);
+
+// How nodes are laid out. Grids and lattices keep their dimensions so that kernels can
+// find neighbours by index arithmetic; general models only have the spring lists.
+enum class Topology : std::uint8_t { general, cloth_grid, lattice };
+
+struct Model {
+  Topology topology = Topology::general;
+  int nx = 0, ny = 0, nz = 0;  // grid dims (cloth: nz = 1); node (i,j,k) = (k*ny + j)*nx + i
+  float spacing = 0.f;         // rest distance between structural neighbours (grids)
+
+  std::vector<Vec3f> rest_position;  // [n] rest (initial) positions
+  std::vector<float> inv_mass;       // [n] 1/m; 0 marks a pinned node
+
+  std::vector<std::int32_t> spring_i, spring_j;  // [s] end nodes, i < j
+  std::vector<float> rest_length;                // [s] from the builder's rest positions
+  std::vector<SpringKind> kind;                  // [s]
+  std::array<float, kSpringKinds> stiffness{};   // per kind, N/m
+  std::array<float, kSpringKinds> damping{};     // per kind, along the spring axis, N s/m
+
+  // Node -> incident springs (CSR): node v's springs are adj_spring[adj_offset[v] ..
+  // adj_offset[v+1]), adj_node holds the spring's other end. [n+1], [2s], [2s].
+  std::vector<std::int32_t> adj_offset, adj_spring, adj_node;
+
+  int node_count() const { return int(rest_position.size()); }
+  int spring_count() const { return int(spring_i.size()); }
+  bool pinned(int v) const { return inv_mass[v] == 0.f; }
+  // Recomputes adj_* from spring_i/j (ordered by spring index within each node).
+  void build_adjacency();
+  // Largest distance between two rest positions' bounding-box corners.
+  float extent() const;
+};
+
+struct Material {
+  std::array<float, kSpringKinds> stiffness{500.f, 500.f, 100.f};
+  std::array<float, kSpringKinds> damping{0.f, 0.f, 0.f};
+  float node_mass = 0.01f;  // kg per node
+};
+
+// Cloth: nx x ny nodes in the x-z plane at height y0, centred on x = z = 0, spacing h.
+// Grid row j = 0 is the "top" row (its corners are the "top corners").
+Model cloth_grid(int nx, int ny, float spacing, float y0, const Material& m);
+// Lattice: nx x ny x nz nodes, y up (layer j = ny-1 is the top), centred on x = z = 0,
+// bottom layer at height y0. Shear springs are the 12 face and 8 body diagonals.
+Model lattice(int nx, int ny, int nz, float spacing, float y0, const Material& m);
+
+// Spring counts in closed form, per kind (what the builders must produce).
+std::array<std::int64_t, kSpringKinds> cloth_spring_counts(std::int64_t nx, std::int64_t ny);
+std::array<std::int64_t, kSpringKinds> lattice_spring_counts(std::int64_t nx, std::int64_t ny,
+                                                             std::int64_t nz);
+
+enum class PinSet : std::uint8_t { none, top_corners, top_row, list };
+// Nodes of a pin set on a grid or lattice model (list: returns `explicit_nodes`, checked).
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& explicit_nodes);
+void pin(Model& m, const std::vector<int>& nodes);
+
+// Bytes a model of this many nodes and springs needs on the host (model + state).
+std::int64_t model_bytes(std::int64_t nodes, std::int64_t springs);
+
+}  // namespace deformlab

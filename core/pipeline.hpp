@@ -1,0 +1,58 @@
+// Pipeline: a force backend + update backend + integrator (+ interop mode), named by one
+// short string. Every pipeline runs the same model, params and schedule.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "integrator.hpp"
+#include "model.hpp"
+#include "params.hpp"
+#include "state.hpp"
+
+namespace deformlab {
+
+class Pipeline {
+ public:
+  virtual ~Pipeline() = default;
+  virtual void set_state(const State& s) = 0;
+  virtual State state() = 0;  // a read-back on GPU pipelines: not for every step
+  virtual void step() = 0;    // advance by params.dt with the integrator's schedule
+  // Largest node displacement |x_{n+1} - x_n| of the last step, computed where the state
+  // lives; NaN when any position or velocity is not finite.
+  virtual double max_displacement() = 0;
+  // How step times are measured ("host clock", "CUDA events", "GL timer queries").
+  virtual std::string timing_method() const { return "host clock (steady_clock)"; }
+};
+
+// What a pipeline needs to be built.
+struct PipelineSetup {
+  const Model& model;
+  const Params& params;
+  Integrator integrator;
+};
+
+struct PipelineEntry {
+  std::string name;
+  std::string summary;
+  bool deterministic = true;  // bitwise equal run to run
+  // Empty when usable on this build and machine, else the reason it is not.
+  std::function<std::string()> unavailable;
+  // Empty when the pipeline runs this integrator, else the reason it does not.
+  std::function<std::string(Integrator)> unsupported;
+  std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make;
+};
+
+class PipelineRegistry {
+ public:
+  void add(PipelineEntry e);
+  const PipelineEntry* find(const std::string& name) const;
+  const std::vector<PipelineEntry>& all() const { return entries_; }
+  std::string names() const;  // comma-separated, for messages
+
+ private:
+  std::vector<PipelineEntry> entries_;
+};
+
+}  // namespace deformlab

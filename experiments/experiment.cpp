@@ -1,0 +1,56 @@
+#include "experiment.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "experiment_files.hpp"
+
+namespace deformlab {
+
+using nlohmann::json;
+
+Experiment parse_experiment(const std::string& text, const std::string& where) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument("experiment file '" + where + "' is not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
+  Experiment x;
+  for (const auto& [k, v] : j.items()) {
+    auto str = [&, &v = v, &k = k] {
+      if (!v.is_string()) throw std::invalid_argument(where + "." + k + ": expected a string");
+      return v.get<std::string>();
+    };
+    if (k == "name") x.name = str();
+    else if (k == "description") x.description = str();
+    else if (k == "pipeline") x.pipeline = str();
+    else if (k == "integrator") x.integrator = str();
+    else if (k == "until_converged") {
+      if (!v.is_boolean()) throw std::invalid_argument(where + ".until_converged: expected true or false");
+      x.until_converged = v.get<bool>();
+    } else if (k == "scene") apply_json(x.scene, v, where + ".scene");
+    else
+      throw std::invalid_argument(where + "." + k +
+                                  ": unknown key (expected name, description, pipeline, integrator, "
+                                  "until_converged, scene)");
+  }
+  return x;
+}
+
+Experiment load_experiment(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot open experiment file '" + path + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_experiment(ss.str(), path);
+}
+
+Experiment default_experiment() {
+  return parse_experiment(std::string(experiment_files::paper_drag_json), "built-in paper-drag.json");
+}
+
+}  // namespace deformlab

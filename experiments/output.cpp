@@ -1,0 +1,134 @@
+#include "output.hpp"
+
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "build_info.hpp"
+
+namespace deformlab {
+
+namespace fs = std::filesystem;
+
+OutputDir::OutputDir(const fs::path& dir) : dir_(dir) {
+  std::error_code ec;
+  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
+    throw std::invalid_argument("output path '" + dir_.string() + "' exists and is not a folder");
+  created_ = !fs::exists(dir_, ec);
+  fs::create_directories(dir_, ec);
+  if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
+  staging_ = dir_ / (".staging-" + std::to_string(::getpid()));
+  fs::remove_all(staging_, ec);
+  fs::create_directory(staging_, ec);
+  if (ec) throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
+}
+
+OutputDir::~OutputDir() {
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+  if (created_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
+}
+
+void OutputDir::commit() {
+  for (const auto& e : fs::directory_iterator(staging_)) {
+    const fs::path target = dir_ / e.path().filename();
+    if (fs::is_directory(e.path()) && fs::exists(target)) fs::remove_all(target);
+    fs::rename(e.path(), target);
+  }
+}
+
+void write_ply(const fs::path& file, const Model& m, const State& s) {
+  std::ofstream out(file, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+  const bool faces = m.topology == Topology::cloth_grid && m.nx > 1 && m.ny > 1;
+  const std::int64_t nf = faces ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : 0;
+  out << "ply\nformat binary_little_endian 1.0\n"
+      << "comment deformlab state at t = " << s.t << " s; positions in m, velocities in m/s\n"
+      << "element vertex " << s.x.size() << "\n"
+      << "property float x\nproperty float y\nproperty float z\n"
+      << "property float vx\nproperty float vy\nproperty float vz\n";
+  if (faces) out << "element face " << nf << "\nproperty list uchar int vertex_indices\n";
+  out << "end_header\n";
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    const float v[6] = {s.x[i].x, s.x[i].y, s.x[i].z, s.v[i].x, s.v[i].y, s.v[i].z};
+    out.write(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  for (int j = 0; faces && j + 1 < m.ny; ++j)
+    for (int i = 0; i + 1 < m.nx; ++i) {
+      const std::int32_t a = j * m.nx + i, b = a + 1, c = a + m.nx, d = c + 1;
+      const std::int32_t tris[2][3] = {{a, c, b}, {b, c, d}};
+      for (const auto& t : tris) {
+        const unsigned char three = 3;
+        out.write(reinterpret_cast<const char*>(&three), 1);
+        out.write(reinterpret_cast<const char*>(t), sizeof t);
+      }
+    }
+  if (!out) throw std::runtime_error("failed writing " + file.string());
+}
+
+void write_timings_csv(const fs::path& file, const RunResult& r) {
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+  out << "step,t_s,step_ms,max_displacement_m\n";
+  out.precision(9);
+  for (const auto& rec : r.records) {
+    out << rec.step << ',' << rec.t << ',' << rec.ms << ',';
+    if (rec.max_displacement == rec.max_displacement) out << rec.max_displacement;
+    out << '\n';
+  }
+  if (!out) throw std::runtime_error("failed writing " + file.string());
+}
+
+void write_json(const fs::path& file, const nlohmann::json& j) {
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+  out << j.dump(2) << '\n';
+  if (!out) throw std::runtime_error("failed writing " + file.string());
+}
+
+nlohmann::json machine_info() {
+  nlohmann::json j;
+  utsname u{};
+  if (uname(&u) == 0) j["os"] = std::string(u.sysname) + " " + u.release + " " + u.machine;
+  std::ifstream cpu("/proc/cpuinfo");
+  for (std::string line; std::getline(cpu, line);)
+    if (line.rfind("model name", 0) == 0) {
+      j["cpu"] = line.substr(line.find(':') + 2);
+      break;
+    }
+  j["hardware_threads"] = std::thread::hardware_concurrency();
+  const std::int64_t mem = available_memory_bytes();
+  if (mem >= 0) j["memory_available_bytes"] = mem;
+  return j;
+}
+
+nlohmann::json build_info() {
+  return {{"deformlab", DEFORMLAB_VERSION},
+          {"git", DEFORMLAB_GIT},
+          {"compiler", DEFORMLAB_COMPILER},
+          {"build_type", DEFORMLAB_BUILD_TYPE},
+          {"cuda", DEFORMLAB_CUDA_VERSION},
+          {"gl", DEFORMLAB_GL_BUILT},
+          {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
+                        std::to_string(EIGEN_MINOR_VERSION)},
+          {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
+                                std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
+                                std::to_string(NLOHMANN_JSON_VERSION_PATCH)}};
+}
+
+std::int64_t available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::int64_t kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return -1;
+}
+
+}  // namespace deformlab

@@ -1,0 +1,49 @@
+// Run outputs. Files are written into a staging folder inside the output folder and moved
+// into place only when the whole run succeeded, so a failed run leaves the folder as it was.
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/model.hpp"
+#include "core/run.hpp"
+#include "core/state.hpp"
+
+namespace deformlab {
+
+class OutputDir {
+ public:
+  // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder).
+  explicit OutputDir(const std::filesystem::path& dir);
+  // Removes the staging folder, and the output folder too if this object created it and
+  // nothing was committed.
+  ~OutputDir();
+  OutputDir(const OutputDir&) = delete;
+  OutputDir& operator=(const OutputDir&) = delete;
+
+  // Where to write a file or folder named `name` before commit().
+  std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
+  // Moves every staged entry into the output folder (replacing entries of the same name).
+  void commit();
+  const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_, staging_;
+  bool created_ = false;
+};
+
+// Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their
+// triangles (two per quad) so mesh tools show the surface. numpy reads it via plyfile.
+void write_ply(const std::filesystem::path& file, const Model& m, const State& s);
+// step,t_s,step_ms,max_displacement_m (empty where the step was not checked).
+void write_timings_csv(const std::filesystem::path& file, const RunResult& r);
+void write_json(const std::filesystem::path& file, const nlohmann::json& j);
+
+// Machine and build facts for manifests.
+nlohmann::json machine_info();
+nlohmann::json build_info();
+
+// Bytes of memory available to this process now (MemAvailable), or -1 if unknown.
+std::int64_t available_memory_bytes();
+
+}  // namespace deformlab
