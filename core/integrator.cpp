@@ -45,17 +45,25 @@ bool Schedule::single_pass() const {
 
 namespace {
 Pass force_pass(int src, int acc, double time_fraction) {
-  Pass p{.op = Pass::Op::force};
+  Pass p;
+  p.op = Pass::Op::force;
   p.src = src; p.acc = acc; p.time_fraction = time_fraction;
   return p;
 }
 Pass stage_pass(int src, int dst, double coef) {  // reads accel slot `src`
-  Pass p{.op = Pass::Op::stage};
+  Pass p;
+  p.op = Pass::Op::stage;
   p.src = src; p.dst = dst; p.acc = src; p.coef = coef;
   return p;
 }
+Pass update_pass(Pass::Op op) {
+  Pass p;
+  p.op = op;
+  return p;
+}
 Pass combine_pass(std::vector<double> weights) {
-  Pass p{.op = Pass::Op::combine};
+  Pass p;
+  p.op = Pass::Op::combine;
   p.weights = std::move(weights);
   return p;
 }
@@ -67,7 +75,7 @@ Schedule make_schedule(Integrator i) {
     case Integrator::explicit_euler:
     case Integrator::semi_implicit_euler:
     case Integrator::verlet:
-      s.passes = {force_pass(0, 0, 0.0), Pass{.op = Pass::Op::fused}};
+      s.passes = {force_pass(0, 0, 0.0), update_pass(Pass::Op::fused)};
       break;
     case Integrator::midpoint:
       s.stage_states = 1;
@@ -82,7 +90,7 @@ Schedule make_schedule(Integrator i) {
                   force_pass(3, 3, 1.0), combine_pass({1.0 / 6, 2.0 / 6, 2.0 / 6, 1.0 / 6})};
       break;
     case Integrator::backward_euler:
-      s.passes = {Pass{.op = Pass::Op::solve}};  // its force evaluation (f0) uses accel slot 0
+      s.passes = {update_pass(Pass::Op::solve)};  // its force evaluation (f0) uses accel slot 0
       break;
   }
   return s;

@@ -43,7 +43,7 @@ struct Pass {
     combine,  // next = state[0] + dt * sum_k weights[k] * (v of state[k], accel[k]); then constraints
     fused,    // next = one-pass update from state[0] and accel[0] (the `update` rule); then constraints
     solve,    // next = backward Euler solve from state[0]; then constraints
-  } op;
+  } op = Op::force;
   int src = 0, dst = 0, acc = 0;
   double coef = 0.0, time_fraction = 0.0;
   std::vector<double> weights;  // combine only: one per stage (state k, accel k)

@@ -1,0 +1,80 @@
+// `deformlab-bench cpu`: the paper's Table 1 shape, cpu vs omp, ms per step.
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "bench.hpp"
+#include "core/cpu_backend.hpp"
+#include "core/state.hpp"
+
+namespace deformlab::bench {
+
+namespace {
+
+struct CpuOptions {
+  std::vector<int> sizes{64, 128, 256, 512};
+  int warmup = 5, reps = 30;
+  std::string integrator = "semi-implicit-euler";
+  std::string csv;
+};
+
+void time_steps(Pipeline& p, int reps, std::vector<double>& ms) {
+  using clock = std::chrono::steady_clock;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = clock::now();
+    p.step();
+    ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+  }
+}
+
+void run_cpu(const CpuOptions& o) {
+  const auto integ = parse_integrator(o.integrator);
+  if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
+  std::cout << "deformlab-bench cpu: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
+            << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
+            << o.reps << " timed steps; omp uses all hardware threads\n\n"
+            << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
+            << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
+  std::ofstream csv;
+  if (!o.csv.empty()) {
+    csv.open(o.csv);
+    csv << "grid,nodes,pipeline,median_ms,min_ms,p90_ms\n";
+  }
+  for (int n : o.sizes) {
+    Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
+    pin(m, pin_nodes(m, PinSet::top_corners, {}));
+    Params p;
+    p.dt = 0.001f;
+    Stats st[2];
+    for (int k = 0; k < 2; ++k) {
+      auto pipe = make_cpu_pipeline({m, p, *integ}, Precision::f32, k == 1);
+      std::vector<double> ms;
+      time_steps(*pipe, o.warmup, ms);
+      ms.clear();
+      time_steps(*pipe, o.reps, ms);
+      st[k] = stats(ms);
+      if (csv) csv << n << "x" << n << "," << m.node_count() << "," << (k ? "omp" : "cpu") << "," << st[k].median
+                   << "," << st[k].min << "," << st[k].p90 << "\n";
+    }
+    std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(12)
+              << st[0].median << std::setw(12) << st[1].median << std::setw(10) << std::setprecision(2)
+              << st[0].median / st[1].median << std::setw(16) << m.node_count() / (st[1].median * 1e3) << "\n";
+  }
+}
+
+}  // namespace
+
+void add_cpu_bench(CLI::App& app) {
+  auto o = std::make_shared<CpuOptions>();
+  auto* c = app.add_subcommand("cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)");
+  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
+  c->add_option("--warmup", o->warmup, "Warm-up steps");
+  c->add_option("--reps", o->reps, "Timed steps");
+  c->add_option("--integrator", o->integrator, "Integrator");
+  c->add_option("--csv", o->csv, "Also write the results to this CSV file");
+  c->callback([o] { run_cpu(*o); });
+}
+
+}  // namespace deformlab::bench

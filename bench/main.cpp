@@ -1,0 +1,35 @@
+#include <algorithm>
+#include <iostream>
+
+#include "bench.hpp"
+
+namespace deformlab::bench {
+
+Stats stats(std::vector<double> ms) {
+  if (ms.empty()) return {};
+  std::sort(ms.begin(), ms.end());
+  return {ms[ms.size() / 2], ms.front(), ms[std::min(ms.size() - 1, ms.size() * 9 / 10)]};
+}
+
+}  // namespace deformlab::bench
+
+int main(int argc, char** argv) {
+  CLI::App cli{"deformlab-bench: timings of deformlab's pipelines (not tests)"};
+  cli.require_subcommand(1);
+  deformlab::bench::add_cpu_bench(cli);
+#if DEFORMLAB_HAVE_CUDA
+  deformlab::bench::add_cuda_bench(cli);
+#endif
+#if DEFORMLAB_HAVE_GL
+  deformlab::bench::add_gl_bench(cli);
+#endif
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e) == 0 ? 0 : 2;
+  } catch (const std::exception& e) {
+    std::cerr << "deformlab-bench: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,31 @@
+// Shared helpers for tests that compare pipelines: small scenes and non-trivial states.
+#pragma once
+#include <cstdint>
+
+#include "core/model.hpp"
+#include "core/params.hpp"
+#include "core/pipeline.hpp"
+#include "core/state.hpp"
+
+namespace deformlab::test {
+
+// A cloth or lattice with the default material (stiffness 500/500/100 N/m, 0.01 kg nodes),
+// spacing 0.05 m, at height 1 m, top corners pinned unless `pinned` is false.
+Model small_cloth(int nx, int ny, bool pinned = true);
+Model small_lattice(int nx, int ny, int nz, bool pinned = true);
+// Params with dt = 1 ms, gravity, global damping 0.02, spring damping set on the model by
+// the caller if wanted, no colliders, no drag.
+Params small_params();
+
+// The rest state moved off rest and set moving: positions jittered by up to `pos_amp`
+// (m) and velocities up to `vel_amp` (m/s), from a fixed seed (deterministic).
+State perturbed_state(const Model& m, std::uint32_t seed, float pos_amp = 0.01f, float vel_amp = 0.2f);
+
+// Largest |a.x - b.x| and |a.v - b.v| over nodes.
+double max_position_diff(const State& a, const State& b);
+double max_velocity_diff(const State& a, const State& b);
+
+// Runs `steps` steps of a pipeline made by `make` from state `s0` and returns the state.
+State advance(Pipeline& p, const State& s0, int steps);
+
+}  // namespace deformlab::test
