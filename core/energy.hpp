@@ -1,0 +1,19 @@
+// Energies of a state, for physics checks: kinetic, spring potential, and the potential of
+// gravity and wind (constant force fields). Pinned nodes carry no kinetic energy.
+#pragma once
+#include "model.hpp"
+#include "params.hpp"
+#include "state.hpp"
+
+namespace deformlab {
+
+struct Energy {
+  double kinetic = 0;  // sum m |v|^2 / 2 over free nodes, J
+  double spring = 0;   // sum k (|d| - l)^2 / 2 over springs, J
+  double field = 0;    // -sum (m g + wind) . x over free nodes, J
+  double total() const { return kinetic + spring + field; }
+};
+
+Energy energy(const Model& m, const Params& p, const State& s);
+
+}  // namespace deformlab
