@@ -1,0 +1,174 @@
+// Physics against analytic solutions: a spring oscillator, free fall, energy behaviour of
+// each integrator, and backward Euler past the explicit stability limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/cpu_backend.hpp"
+#include "core/energy.hpp"
+#include "core/run.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab {
+namespace {
+
+// Node 0 pinned at (-l, 0, 0), node 1 of mass m at rest at the origin (so its float
+// read-back keeps full precision) on a spring of stiffness k, rest length l.
+Model two_node_spring(float k, float mass, float rest) {
+  Model m;
+  m.rest_position = {{-rest, 0.f, 0.f}, {0.f, 0.f, 0.f}};
+  m.inv_mass = {0.f, 1.f / mass};
+  m.spring_i = {0};
+  m.spring_j = {1};
+  m.rest_length = {rest};
+  m.kind = {SpringKind::structural};
+  m.stiffness = {k, k, k};
+  m.build_adjacency();
+  return m;
+}
+
+Params no_forces(float dt) {
+  Params p;
+  p.dt = dt;
+  p.gravity = {};
+  p.damping = 0.f;
+  return p;
+}
+
+struct Oscillation {
+  double period = 0, amplitude = 0, max_error = 0;
+};
+
+// Runs the oscillator for `periods` analytic periods, measuring the period from upward
+// zero crossings of the displacement and the amplitude from its extremes.
+Oscillation oscillate(Integrator integ, double dt, double periods) {
+  const float k = 100.f, mass = 1.f, rest = 1.f, amp = 0.1f;
+  const double w = std::sqrt(double(k) / mass), period = 2 * std::numbers::pi / w;
+  const Model m = two_node_spring(k, mass, rest);
+  const Params p = no_forces(float(dt));
+  auto pipe = make_cpu_pipeline({m, p, integ}, Precision::f64, false);
+  State s = rest_state(m);
+  s.x[1].x += amp;
+  pipe->set_state(s);
+  Oscillation o;
+  double prev = amp, first_up = -1, last_up = -1;
+  int ups = 0;
+  const int steps = int(std::round(periods * period / dt));
+  for (int n = 1; n <= steps; ++n) {
+    pipe->step();
+    const double t = n * double(p.dt), u = pipe->state().x[1].x;
+    o.amplitude = std::max(o.amplitude, std::abs(u));
+    o.max_error = std::max(o.max_error, std::abs(u - amp * std::cos(w * t)));
+    if (prev < 0 && u >= 0) {
+      const double tc = t - dt * u / (u - prev);  // linear interpolation of the crossing
+      if (first_up < 0) first_up = tc;
+      last_up = tc;
+      ++ups;
+    }
+    prev = u;
+  }
+  o.period = ups > 1 ? (last_up - first_up) / (ups - 1) : 0;
+  return o;
+}
+
+TEST(Oscillator, Rk4MatchesTheAnalyticSolution) {
+  const double period = 2 * std::numbers::pi / 10.0;
+  const Oscillation o = oscillate(Integrator::rk4, 1.0 / 1024, 5);  // dt exact in float
+  EXPECT_NEAR(o.period, period, 1e-6 * period);
+  EXPECT_NEAR(o.amplitude, 0.1, 1e-6);
+  EXPECT_LT(o.max_error, 1e-7);  // RK4 global error ~ A w t (w dt)^4 / 120 = 1e-8, plus float read-back
+}
+
+TEST(Oscillator, EveryIntegratorKeepsPeriodAndAmplitude) {
+  const double period = 2 * std::numbers::pi / 10.0;
+  for (const auto& i : integrators()) {
+    if (i.id == Integrator::explicit_euler || i.id == Integrator::backward_euler) continue;
+    const Oscillation o = oscillate(i.id, 1e-3, 5);
+    // Phase error of the second-order-accurate-in-phase schemes is O((w dt)^2) = 1e-4.
+    EXPECT_NEAR(o.period, period, 1e-3 * period) << i.name;
+    // Symplectic Euler's amplitude error is O(w dt) = 1e-2 (it keeps a modified energy).
+    EXPECT_NEAR(o.amplitude, 0.1, 0.1 * 0.011) << i.name;
+  }
+  // The non-symplectic first-order schemes drift: explicit grows, backward decays, each
+  // by a factor (1 + (w dt)^2)^(+-n/2) over n steps.
+  const double grow = std::pow(1 + 1e-4, 0.5 * 5 * period / 1e-3);
+  EXPECT_NEAR(oscillate(Integrator::explicit_euler, 1e-3, 5).amplitude, 0.1 * grow, 0.1 * 0.01 * grow);
+  EXPECT_LT(oscillate(Integrator::backward_euler, 1e-3, 5).amplitude, 0.1);
+}
+
+TEST(FreeFall, MatchesHalfGTSquared) {
+  Model m;
+  m.rest_position = {{0.f, 10.f, 0.f}};
+  m.inv_mass = {1.f};
+  m.build_adjacency();
+  Params p;
+  p.damping = 0.f;
+  p.dt = 0.01f;
+  const double g = 9.81, dt = p.dt;
+  const int n = 100;
+  const double t = n * dt, exact = 10.0 - 0.5 * g * t * t;
+  for (const auto& i : integrators()) {
+    auto pipe = make_cpu_pipeline({m, p, i.id}, Precision::f64, false);
+    for (int k = 0; k < n; ++k) pipe->step();
+    const double y = pipe->state().x[0].y;
+    // (the state is read back as float: 1e-6 relative)
+    if (i.order >= 2) {
+      EXPECT_NEAR(y, exact, 1e-5) << i.name << ": exact for constant acceleration";
+    } else {
+      // explicit Euler lags by g t dt / 2; semi-implicit and backward Euler lead by it.
+      const double lag = i.id == Integrator::explicit_euler ? -1.0 : 1.0;
+      EXPECT_NEAR(y, exact - lag * 0.5 * g * t * dt, 1e-5) << i.name;
+    }
+  }
+}
+
+// Undamped, unpinned, no gravity: a soft cloth released from a perturbed state.
+double energy_drift(Integrator integ, int steps, double* final_ratio) {
+  Material mat;
+  mat.stiffness = {10.f, 10.f, 10.f};
+  const Model m = cloth_grid(8, 8, 0.05f, 1.f, mat);
+  Params p = no_forces(1e-4f);
+  auto pipe = make_cpu_pipeline({m, p, integ}, Precision::f64, false);
+  State s = test::perturbed_state(m, 7, 0.01f, 0.f);
+  pipe->set_state(s);
+  const double e0 = energy(m, p, s).total();
+  double worst = 0;
+  double e = e0;
+  for (int k = 0; k < steps; ++k) {
+    pipe->step();
+    e = energy(m, p, pipe->state()).total();
+    worst = std::max(worst, std::abs(e - e0) / e0);
+  }
+  *final_ratio = e / e0;
+  return worst;
+}
+
+TEST(Energy, SymplecticSchemesBoundedExplicitEulerGrows) {
+  double ratio = 0;
+  EXPECT_LT(energy_drift(Integrator::semi_implicit_euler, 10000, &ratio), 0.02);
+  EXPECT_LT(energy_drift(Integrator::verlet, 10000, &ratio), 0.02);
+  energy_drift(Integrator::explicit_euler, 10000, &ratio);
+  EXPECT_GT(ratio, 1.2) << "explicit Euler should gain energy";
+}
+
+TEST(BackwardEuler, StableAtTenTimesTheExplicitLimit) {
+  Model m = test::small_cloth(16, 16);
+  Params p = test::small_params();
+  const double limit = explicit_stability_limit(m, p);
+  p.dt = float(10 * limit);
+  p.max_steps = 400;
+  auto be = make_cpu_pipeline({m, p, Integrator::backward_euler}, Precision::f32, true);
+  const double e0 = energy(m, p, rest_state(m)).total();
+  RunResult r = run(*be, m, p, {});
+  EXPECT_EQ(r.steps, 400);
+  const Energy e = energy(m, p, be->state());
+  EXPECT_LT(e.total(), e0) << "backward Euler dissipates: the cloth settles below its start";
+  EXPECT_LT(r.last_displacement, 1e-2);
+  // The same step breaks the explicit schemes.
+  auto se = make_cpu_pipeline({m, p, Integrator::semi_implicit_euler}, Precision::f32, true);
+  EXPECT_THROW(run(*se, m, p, {}), DivergenceError);
+}
+
+}  // namespace
+}  // namespace deformlab

@@ -1,0 +1,88 @@
+// Scene and experiment files: every key read, unknown keys and bad values named.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/scene.hpp"
+#include "experiments/experiment.hpp"
+
+namespace deformlab {
+namespace {
+
+using nlohmann::json;
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_experiment(text, "x.json");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scene, BuiltInExperimentIsThePapersDrag) {
+  const Experiment x = default_experiment();
+  EXPECT_EQ(x.name, "paper-drag");
+  EXPECT_EQ(x.scene.model.nx, 128);
+  EXPECT_EQ(x.scene.model.ny, 128);
+  EXPECT_EQ(x.scene.model.pins, PinSet::top_corners);
+  EXPECT_FLOAT_EQ(x.scene.params.threshold, 0.001f);
+  EXPECT_TRUE(x.until_converged);
+  const Model m = build_model(x.scene);
+  const Params p = resolve_params(x.scene, m);
+  EXPECT_EQ(p.drag.node, 64 * 128 + 64);
+  // Offsets in the file become positions relative to the node's rest position.
+  EXPECT_EQ(p.drag.path.back().position, m.rest_position[p.drag.node]);
+  EXPECT_TRUE(m.pinned(0) && m.pinned(127));
+}
+
+TEST(Scene, ReadsEveryKeyAndRoundTrips) {
+  Scene s;
+  apply_json(s, json::parse(R"({
+    "model": {"type": "lattice", "size": [4, 5, 6], "spacing": 0.1, "node_mass": 0.02,
+              "stiffness": {"structural": 10, "shear": 20, "flexion": 30}, "damping": 0.5, "pins": [1, 2]},
+    "dt": 0.004, "gravity": [0, -1, 0], "damping": 0.3, "wind": [1, 0, 0], "ground": -2,
+    "spheres": [{"center": [0, 1, 0], "radius": 0.5}],
+    "drag": {"node": 7, "mode": "spring", "stiffness": 50, "path_is": "position", "path": [[0, 1, 2, 3]]},
+    "threshold": 0.01, "min_steps": 3, "max_steps": 99, "check_every": 4, "runaway_factor": 2})"), "s");
+  EXPECT_EQ(s.model.topology, Topology::lattice);
+  EXPECT_EQ(s.model.nz, 6);
+  EXPECT_EQ(s.model.material.stiffness[2], 30.f);
+  EXPECT_EQ(s.model.material.damping[1], 0.5f);
+  EXPECT_EQ(s.model.pin_list, (std::vector<int>{1, 2}));
+  EXPECT_EQ(*s.params.ground, -2.f);
+  EXPECT_TRUE(s.params.drag.as_spring);
+  EXPECT_EQ(s.params.check_every, 4);
+  Scene t;
+  apply_json(t, to_json(s), "t");
+  EXPECT_EQ(to_json(t), to_json(s));
+  const Model m = build_model(t);
+  EXPECT_TRUE(m.pinned(1) && m.pinned(2) && !m.pinned(0));
+  EXPECT_EQ(resolve_params(t, m).drag.path[0].position, (Vec3f{1, 2, 3}));
+}
+
+TEST(Scene, ErrorsNameTheKey) {
+  EXPECT_NE(error_of(R"({"scene": {"dtt": 1}})").find("x.json.scene.dtt: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"dt": "fast"}})").find("x.json.scene.dt: expected a number"), std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"model": {"size": [0]}}})").find("x.json.scene.model.size"), std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"model": {"pins": "corners"}}})").find("pins"), std::string::npos);
+  EXPECT_NE(error_of(R"({"pipeline": 3})").find("x.json.pipeline: expected a string"), std::string::npos);
+  EXPECT_NE(error_of("{not json").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"drag": {"path": [[0, 1, 2]]}}})").find("[t, x, y, z]"), std::string::npos);
+}
+
+TEST(Scene, ResolveRejectsBadValues) {
+  Scene s;
+  s.model.nx = s.model.ny = 4;
+  s.params.dt = -1.f;
+  const Model m = build_model(s);
+  EXPECT_THROW(resolve_params(s, m), std::invalid_argument);
+  s.params.dt = 0.001f;
+  apply_json(s, json::parse(R"({"drag": {"node": 99, "path": [[0, 0, 0, 0]]}})"), "s");
+  EXPECT_THROW(resolve_params(s, m), std::invalid_argument);
+  apply_json(s, json::parse(R"({"drag": {"node": 3, "path": [[1, 0, 0, 0], [0.5, 0, 0, 0]]}})"), "s");
+  EXPECT_THROW(resolve_params(s, m), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace deformlab
