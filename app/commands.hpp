@@ -10,6 +10,7 @@ namespace deformlab::app {
 struct RunArgs {
   std::vector<std::string> argv;  // the whole command, for the manifest
   std::optional<std::string> experiment, scene, pipeline, integrator, grid, lattice, compare;
+  std::vector<std::string> options;  // pipeline options, NAME=VALUE
   std::optional<int> steps, check_every;
   std::optional<double> dt, threshold;
   bool until_converged = false;

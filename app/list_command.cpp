@@ -17,6 +17,7 @@ int list_command() {
       std::cout << "  " << std::setw(15) << "" << "  why: " << why << "\n";
       continue;
     }
+    for (const auto& o : e.options) std::cout << "  " << std::setw(15) << "" << "  option: " << o << "\n";
     for (const auto& i : integrators())
       if (const auto no = e.unsupported(i.id); !no.empty())
         std::cout << "  " << std::setw(15) << "" << "  no " << i.name << ": " << no << "\n";

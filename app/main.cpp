@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   run->add_option("--dt", a.dt, "Time step, s");
   run->add_option("--threshold", a.threshold, "Convergence threshold, m per step");
   run->add_option("--check-every", a.check_every, "Steps between convergence and divergence checks");
+  run->add_option("--option", a.options, "Pipeline option NAME=VALUE (repeatable; 'deformlab list' names them)");
   run->add_option("--compare", a.compare, "Also run the double-precision reference ('cpu') and report the error");
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
 

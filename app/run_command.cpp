@@ -65,6 +65,7 @@ int run_command(const RunArgs& a) {
   Model model;
   Params params;
   bool until_converged = false;
+  PipelineOptions options;
   try {
     x = a.experiment ? load_experiment(*a.experiment) : default_experiment();
     if (a.scene) {
@@ -86,6 +87,16 @@ int run_command(const RunArgs& a) {
       throw BadInput("pipeline '" + entry->name + "' is not available: " + why);
     if (const auto why = entry->unsupported(integ); !why.empty())
       throw BadInput("integrator '" + x.integrator + "' is not available on " + entry->name + ": " + why);
+
+    for (const auto& o : a.options) {
+      const auto eq = o.find('=');
+      if (eq == std::string::npos || eq == 0) throw BadInput("--option '" + o + "': expected NAME=VALUE");
+      const std::string name = o.substr(0, eq);
+      if (std::find(entry->options.begin(), entry->options.end(), name) == entry->options.end())
+        throw BadInput("--option '" + name + "' is not an option of " + entry->name +
+                       (entry->options.empty() ? " (it has none)" : ""));
+      options[name] = o.substr(eq + 1);
+    }
 
     ModelSpec& ms = x.scene.model;
     if (a.grid) {
@@ -136,7 +147,7 @@ int run_command(const RunArgs& a) {
   try {
     const std::string out = a.out ? *a.out : "runs/" + (x.name.empty() ? std::string("run") : x.name);
     OutputDir dir(out);
-    auto pipe = entry->make({model, params, integ});
+    auto pipe = entry->make({model, params, integ, options});
     pipe->set_state(rest_state(model));
     RunOptions opt;
     opt.until_converged = until_converged;
@@ -169,6 +180,7 @@ int run_command(const RunArgs& a) {
         {"pipeline", entry->name},
         {"integrator", std::string(info(integ).name)},
         {"until_converged", until_converged},
+        {"options", options},
         {"scene", scene},
         {"model", {{"nodes", model.node_count()}, {"springs", model.spring_count()},
                    {"drag_node", params.drag.node}, {"explicit_stability_limit_s", limit}}},

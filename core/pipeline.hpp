@@ -2,6 +2,7 @@
 // short string. Every pipeline runs the same model, params and schedule.
 #pragma once
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,11 +27,16 @@ class Pipeline {
   virtual std::string timing_method() const { return "host clock (steady_clock)"; }
 };
 
+// Per-pipeline settings by name, e.g. {"tile": "16x8"} or {"interop": "map"}; each
+// pipeline lists the names it reads in its registry entry (PipelineEntry::options).
+using PipelineOptions = std::map<std::string, std::string>;
+
 // What a pipeline needs to be built.
 struct PipelineSetup {
   const Model& model;
   const Params& params;
   Integrator integrator;
+  PipelineOptions options = {};
 };
 
 struct PipelineEntry {
@@ -42,6 +48,7 @@ struct PipelineEntry {
   // Empty when the pipeline runs this integrator, else the reason it does not.
   std::function<std::string(Integrator)> unsupported;
   std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make;
+  std::vector<std::string> options = {};  // option names it reads (see PipelineOptions)
 };
 
 class PipelineRegistry {

@@ -123,6 +123,8 @@ TEST_F(Cli, BadInputsAreRefused) {
   expect_refused("run --scene " + write("bad.json", "{\"dt\": ").string(), "is not valid JSON");
   expect_refused("run --scene " + write("key.json", "{\"dtt\": 1}").string(), "dtt: unknown key");
   expect_refused("run --experiment " + write("x.json", "{\"pipline\": \"cpu\"}").string(), "pipline: unknown key");
+  expect_refused("run --pipeline cpu --option tile=8x8", "--option 'tile' is not an option of cpu");
+  expect_refused("run --option tile", "expected NAME=VALUE");
   expect_refused("run --grid 100000x100000", "GiB of memory");
   expect_refused("run --lattice 2000x2000x2000", "GiB of memory");
   expect_refused("run --pipeline cpu --integrator rk4 --grid 4x4 --scene " +
