@@ -5,12 +5,14 @@ function(deformlab_embed)
   cmake_parse_arguments(E "" "TARGET;NAMESPACE" "FILES" ${ARGN})
   set(out ${CMAKE_CURRENT_BINARY_DIR}/${E_TARGET}.cpp)
   set(hdr ${CMAKE_CURRENT_BINARY_DIR}/include/${E_TARGET}.hpp)
+  # The list reaches the script joined by "|": a ";" would split the command.
+  list(JOIN E_FILES "|" files)
   add_custom_command(
     OUTPUT ${out} ${hdr}
     COMMAND ${CMAKE_COMMAND} -DOUT=${out} -DHDR=${hdr} -DNS=${E_NAMESPACE}
-            "-DFILES=${E_FILES}" -P ${PROJECT_SOURCE_DIR}/cmake/EmbedScript.cmake
+            "-DFILES=${files}" -P ${PROJECT_SOURCE_DIR}/cmake/EmbedScript.cmake
     DEPENDS ${E_FILES} ${PROJECT_SOURCE_DIR}/cmake/EmbedScript.cmake
-    COMMENT "Embedding ${E_TARGET}")
+    COMMENT "Embedding ${E_TARGET}" VERBATIM)
   add_library(${E_TARGET} STATIC ${out})
   target_include_directories(${E_TARGET} PUBLIC ${CMAKE_CURRENT_BINARY_DIR}/include)
 endfunction()

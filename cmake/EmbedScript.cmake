@@ -1,4 +1,5 @@
 # Script mode: writes HDR and OUT embedding FILES into namespace NS (see EmbedFiles.cmake).
+string(REPLACE "|" ";" FILES "${FILES}")
 set(decl "")
 set(defs "")
 set(table "")

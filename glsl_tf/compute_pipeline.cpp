@@ -1,0 +1,39 @@
+// glsl-compute: the same passes as glsl-tf, as compute shaders over storage buffers.
+#include "gl_pipeline.hpp"
+#include "pipelines_internal.hpp"
+
+namespace deformlab::gl {
+namespace {
+
+class ComputePipeline final : public GlPipeline {
+ public:
+  explicit ComputePipeline(const PipelineSetup& s) : GlPipeline(s, "glsl-compute") {
+    GLint blocks = 0;
+    glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
+    if (blocks < 11) throw std::invalid_argument("glsl-compute needs 11 storage buffers per compute shader");
+    init();
+  }
+
+ private:
+  Program make_program(PassKind, const std::string& defines) override {
+    return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines);
+  }
+
+  void run_pass(GLuint program, const PassIO& io) override {
+    const NodeBuffer* in[7] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v, io.acc_x, io.acc_v};
+    for (int k = 0; k < 7; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->buf.id());
+    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7 + k, io.out[k]->buf.id());
+    glUseProgram(program);
+    glDispatchCompute(GLuint((n_ + 255) / 256), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(0);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s) {
+  return std::make_unique<ComputePipeline>(s);
+}
+
+}  // namespace deformlab::gl

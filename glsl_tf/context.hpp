@@ -1,0 +1,66 @@
+// The process-wide headless OpenGL context (EGL, no window system) and the GL helpers every
+// GL stage shares: error checks named by stage, GPU or host timers, the shader sources.
+#pragma once
+#define EGL_NO_X11
+#include <GL/glew.h>
+
+#include <chrono>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace deformlab::gl {
+
+struct ContextOptions {
+  int device = -1;     // EGL device index; -1: the first with EGL_NV_device_cuda, else the first
+  bool debug = false;  // KHR_debug callback, every pass checked (also DEFORMLAB_GL_DEBUG=1)
+};
+// Must be called before the context is first used; throws std::invalid_argument if it is
+// already made with other options.
+void configure(const ContextOptions& o);
+
+struct ContextInfo {
+  std::string vendor, renderer, version, platform;  // platform: how EGL found the display
+  bool software = false;  // a CPU rasteriser (llvmpipe): GL timer queries are not meaningful
+  bool debug = false;
+};
+
+// Makes the context current, creating it on first use. Throws std::invalid_argument with
+// one clear reason (no EGL display, no driver, GL older than 4.3 core) when it cannot.
+const ContextInfo& context();
+// Empty when a context can be made here, else the reason it cannot.
+std::string unavailable_reason();
+// True once a context exists (so that manifests can report it without creating one).
+bool context_created();
+
+// Throws std::runtime_error naming `stage` if GL reports an error (all pending errors listed).
+void check(std::string_view stage);
+// Checks after each pass only in debug mode (the per-step check() always runs).
+void check_debug(std::string_view stage);
+
+// An embedded shader file (DEFORMLAB_SHADER_DIR, if set, overrides the embedded copies).
+std::string shader_file(std::string_view name);
+
+// Times spans of GL work: GL_TIME_ELAPSED queries on a GPU, the host clock after glFinish
+// on a software rasteriser (whose queries read about 1 ns). Spans may not nest.
+class Timer {
+ public:
+  Timer();
+  ~Timer();
+  Timer(const Timer&) = delete;
+  Timer& operator=(const Timer&) = delete;
+  void begin();
+  void end();
+  // Finished spans since the last call, ms, in order (waits for pending queries).
+  std::vector<double> take();
+  std::string method() const;
+
+ private:
+  void collect(std::size_t keep);  // waits for all but the newest `keep` queries
+  bool software_;
+  std::vector<unsigned> free_, pending_;
+  std::vector<double> done_;
+  std::chrono::steady_clock::time_point t0_;
+};
+
+}  // namespace deformlab::gl

@@ -1,0 +1,100 @@
+// What the glsl-tf and glsl-compute pipelines share: the model and state on the GPU, the
+// integrator's schedule as GPU passes, the displacement reduction and the timers. The two
+// differ only in how a pass runs (transform feedback or compute shader).
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/pipeline.hpp"
+#include "objects.hpp"
+
+namespace deformlab::gl {
+
+// The half stencil of a grid or lattice model when every spring of one grid offset has the
+// same kind and rest length (then kernels find neighbours by arithmetic), else empty.
+struct StencilOffset {
+  int di, dj, dk, kind;
+  float rest;
+};
+std::vector<StencilOffset> grid_stencil(const Model& m);
+
+class GlPipeline : public Pipeline {
+ public:
+  ~GlPipeline() override;
+  void set_state(const State& s) override;
+  State state() override;
+  void step() override;
+  double max_displacement() override;
+  std::string timing_method() const override { return timer_->method(); }
+
+  // The current positions, one vec4 per node (w: inverse mass), ready to be read by GL.
+  GLuint position_buffer();
+  // GPU time of each step since the last call, ms (timing_method() says how it is taken).
+  std::vector<double> take_step_ms() { return timer_->take(); }
+  // "grid arithmetic" or "adjacency buffer": how the shaders find a node's springs.
+  std::string neighbour_mode() const { return stencil_.empty() ? "adjacency buffer" : "grid arithmetic"; }
+
+ protected:
+  enum class PassKind { explicit_euler, semi_implicit_euler, verlet, stage, combine };
+  struct NodeBuffer {
+    Buffer buf;
+    Texture tex;  // texture buffer view (RGBA32F)
+  };
+  // What one pass reads and writes. s0: the current state (and Verlet's previous
+  // positions); src: the state the forces are evaluated at; acc: the running sums.
+  struct PassIO {
+    int set;  // index of the current state set (VAO set of the TF pipeline)
+    const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v, *acc_x, *acc_v;
+    std::array<const NodeBuffer*, 4> out;
+    int outputs;
+  };
+
+  GlPipeline(const PipelineSetup& s, std::string name);
+  // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
+  void init();
+  // `defines` selects the pass kind and the neighbour mode (see shaders/sim.glsl).
+  virtual Program make_program(PassKind kind, const std::string& defines) = 0;
+  virtual void run_pass(GLuint program, const PassIO& io) = 0;
+  // The state was replaced from the host.
+  virtual void on_set_state() {}
+  void bind_model_textures() const;  // adjacency texture buffers (general models)
+
+  int n_ = 0;
+  const std::string name_;
+  std::array<NodeBuffer, 2> x_, v_, xp_;      // state sets, ping-pong (xp_: Verlet)
+  std::array<NodeBuffer, 2> sx_, sv_, ax_, av_;  // stage states and running sums, ping-pong
+
+ private:
+  struct GpuPass {
+    PassKind kind;
+    int src_slot;  // stage slot the forces are evaluated at; -1: the current state
+    int out_slot;  // stage slot written (stage passes)
+    float h, weight;
+    double time_fraction;
+    bool first;
+  };
+  struct PassProgram {
+    Program prog;
+    GLint drag_force_target, drag_next, stage_h, weight, first, has_prev;
+  };
+  void plan(const Schedule& s);
+
+  const Model& m_;
+  const Params p_;
+  const Integrator integrator_;
+  std::vector<StencilOffset> stencil_;
+  std::vector<GpuPass> passes_;
+  std::array<PassProgram, 5> programs_;
+  Buffer params_ubo_, adj_offset_, adj_entry_, adj_rest_, result_;
+  Texture adj_offset_tex_, adj_entry_tex_, adj_rest_tex_;
+  Program reduce_;
+  GLint reduce_n_ = -1;
+  std::unique_ptr<Timer> timer_;
+  int cur_ = 0;
+  bool has_prev_ = false, stepped_ = false;
+  double t_ = 0.0;
+};
+
+}  // namespace deformlab::gl

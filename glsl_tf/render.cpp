@@ -1,0 +1,267 @@
+#include "render.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "gl_pipeline.hpp"
+
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+
+namespace deformlab::gl {
+namespace {
+
+using Mat4 = std::array<float, 16>;  // column-major
+
+Mat4 mul(const Mat4& a, const Mat4& b) {
+  Mat4 r{};
+  for (int c = 0; c < 4; ++c)
+    for (int rr = 0; rr < 4; ++rr)
+      for (int k = 0; k < 4; ++k) r[c * 4 + rr] += a[k * 4 + rr] * b[c * 4 + k];
+  return r;
+}
+
+Vec3f normalized(Vec3f v) { return v * (1.f / norm(v)); }
+Vec3f cross(const Vec3f& a, const Vec3f& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+Mat4 look_at(Vec3f eye, Vec3f at, Vec3f up) {
+  const Vec3f f = normalized(at - eye), s = normalized(cross(f, up)), u = cross(s, f);
+  return {s.x, u.x, -f.x, 0, s.y, u.y, -f.y, 0, s.z, u.z, -f.z, 0, -dot(s, eye), -dot(u, eye), dot(f, eye), 1};
+}
+
+Mat4 perspective(float fovy, float aspect, float znear, float zfar) {
+  const float t = 1.f / std::tan(fovy / 2);
+  return {t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (zfar + znear) / (znear - zfar), -1,
+          0, 0, 2 * zfar * znear / (znear - zfar), 0};
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  const Model& m;
+  RenderOptions o;
+  bool surface;
+  Framebuffer fbo;
+  Renderbuffer color, depth;
+  Program prog;
+  VertexArray vao;
+  Buffer upload, indices;
+  Texture upload_tex, draw_tex;
+  GLsizei index_count = 0;
+  Mat4 view_proj{};
+  Vec3f eye;
+  Timer timer;
+
+  Impl(const Model& model, RenderOptions opt) : m(model), o(opt) {
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+      throw std::invalid_argument("frame size must be between 1 and 16384 pixels");
+    surface = o.mode == RenderOptions::Mode::surface ||
+              (o.mode == RenderOptions::Mode::automatic && m.topology == Topology::cloth_grid);
+    if (surface && (m.topology != Topology::cloth_grid || m.nx < 2 || m.ny < 2))
+      throw std::invalid_argument("surface rendering needs a cloth grid of at least 2x2 nodes");
+    GLuint id = 0;
+    glGenRenderbuffers(1, &id);
+    color = Renderbuffer(id);
+    glBindRenderbuffer(GL_RENDERBUFFER, id);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, o.width, o.height);
+    glGenRenderbuffers(1, &id);
+    depth = Renderbuffer(id);
+    glBindRenderbuffer(GL_RENDERBUFFER, id);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, o.width, o.height);
+    glGenFramebuffers(1, &id);
+    fbo = Framebuffer(id);
+    glBindFramebuffer(GL_FRAMEBUFFER, id);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color.id());
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth.id());
+    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!complete) throw std::runtime_error("the render framebuffer is incomplete");
+    prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
+    glGenVertexArrays(1, &id);
+    vao = VertexArray(id);
+    if (surface) {
+      std::vector<std::uint32_t> idx;
+      idx.reserve(std::size_t(m.nx - 1) * (m.ny - 1) * 6);
+      for (int j = 0; j + 1 < m.ny; ++j)
+        for (int i = 0; i + 1 < m.nx; ++i) {
+          const std::uint32_t a = std::uint32_t(j * m.nx + i), b = a + 1, c = a + std::uint32_t(m.nx), d = c + 1;
+          idx.insert(idx.end(), {a, c, b, b, c, d});
+        }
+      index_count = GLsizei(idx.size());
+      indices = make_buffer(idx.size() * 4, idx.data());
+      glBindVertexArray(vao.id());
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indices.id());
+      glBindVertexArray(0);
+    }
+    // Camera: in front of and above the rest shape, looking at its centre.
+    Vec3f lo = m.rest_position[0], hi = lo;
+    for (const auto& p : m.rest_position)
+      for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+    const Vec3f centre = (lo + hi) * 0.5f;
+    const float radius = std::max(0.5f * norm(hi - lo), 1e-3f);
+    eye = centre + Vec3f{0.f, 0.9f, 2.2f} * radius;
+    const float dist = norm(eye - centre);
+    view_proj = mul(perspective(0.8f, float(o.width) / float(o.height), dist * 0.05f, dist * 4.f),
+                    look_at(eye, centre, {0.f, 1.f, 0.f}));
+    check("renderer setup");
+  }
+
+  void draw_buffer(GLuint positions) {
+    if (!draw_tex || draw_source != positions) {
+      draw_tex = make_texture_buffer(positions, GL_RGBA32F);
+      draw_source = positions;
+    }
+    timer.begin();
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+    glViewport(0, 0, o.width, o.height);
+    glClearColor(0.12f, 0.13f, 0.15f, 1.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glUseProgram(prog.id());
+    glUniformMatrix4fv(uniform(prog.id(), "u_view_proj"), 1, GL_FALSE, view_proj.data());
+    glUniform2i(uniform(prog.id(), "u_grid"), m.nx, m.ny);
+    glUniform1i(uniform(prog.id(), "u_surface"), surface ? 1 : 0);
+    glUniform1f(uniform(prog.id(), "u_point_size"),
+                std::clamp(float(o.width) / std::sqrt(float(m.node_count())) * 0.4f, 1.f, 8.f));
+    glUniform3f(uniform(prog.id(), "u_eye"), eye.x, eye.y, eye.z);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_BUFFER, draw_tex.id());
+    glBindVertexArray(vao.id());
+    if (surface)
+      glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+    else
+      glDrawArrays(GL_POINTS, 0, m.node_count());
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_DEPTH_TEST);
+    timer.end();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    check("rendering a frame");
+  }
+
+  GLuint draw_source = 0;
+};
+
+Renderer::Renderer(const Model& m, RenderOptions o) {
+  context();
+  impl_ = std::make_unique<Impl>(m, o);
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::draw(Pipeline& p) {
+  context();
+  if (auto* g = dynamic_cast<GlPipeline*>(&p))
+    impl_->draw_buffer(g->position_buffer());
+  else
+    draw(p.state());
+}
+
+void Renderer::draw(const State& s) {
+  context();
+  Impl& r = *impl_;
+  const std::size_t n = std::size_t(r.m.node_count());
+  if (s.x.size() != n) throw std::invalid_argument("state size does not match the model");
+  std::vector<float> data(4 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    data[4 * i] = s.x[i].x;
+    data[4 * i + 1] = s.x[i].y;
+    data[4 * i + 2] = s.x[i].z;
+    data[4 * i + 3] = r.m.inv_mass[i];
+  }
+  if (!r.upload) {
+    r.upload = make_buffer(data.size() * 4, data.data());
+  } else {
+    glBindBuffer(GL_ARRAY_BUFFER, r.upload.id());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(data.size() * 4), data.data());
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+  }
+  r.draw_buffer(r.upload.id());
+}
+
+std::vector<std::uint8_t> Renderer::pixels() {
+  context();
+  const Impl& r = *impl_;
+  std::vector<std::uint8_t> px(std::size_t(r.o.width) * r.o.height * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo.id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, r.o.width, r.o.height, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  check("reading a frame back");
+  // GL rows start at the bottom.
+  const std::size_t row = std::size_t(r.o.width) * 4;
+  for (int y = 0; y < r.o.height / 2; ++y)
+    std::swap_ranges(px.begin() + long(y * row), px.begin() + long((y + 1) * row),
+                     px.begin() + long((r.o.height - 1 - y) * row));
+  return px;
+}
+
+void Renderer::write_png(const std::filesystem::path& file) {
+  const auto px = pixels();
+  if (!stbi_write_png(file.string().c_str(), impl_->o.width, impl_->o.height, 4, px.data(), impl_->o.width * 4))
+    throw std::runtime_error("cannot write " + file.string());
+}
+
+std::vector<double> Renderer::take_draw_ms() { return impl_->timer.take(); }
+std::string Renderer::timing_method() const { return impl_->timer.method(); }
+int Renderer::width() const { return impl_->o.width; }
+int Renderer::height() const { return impl_->o.height; }
+
+FrameWriter::FrameWriter(const Model& m, std::filesystem::path dir, int every, RenderOptions o)
+    : r_(m, o), dir_(std::move(dir)), every_(every) {
+  if (every_ < 1) throw std::invalid_argument("--frames must be at least 1");
+  std::filesystem::create_directories(dir_);
+}
+
+void FrameWriter::write(Pipeline& p, int step) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.png", step);
+  r_.draw(p);
+  r_.write_png(dir_ / name);
+  const auto ms = r_.take_draw_ms();
+  draw_ms_.insert(draw_ms_.end(), ms.begin(), ms.end());
+  last_written_ = step;
+  ++frames_;
+}
+
+void FrameWriter::after_step(Pipeline& p, int step) {
+  if (step % every_ == 0) write(p, step);
+}
+
+void FrameWriter::finish(Pipeline& p, int last_step) {
+  if (last_written_ != last_step) write(p, last_step);
+  if (frames_ < 2 || std::system("command -v ffmpeg >/dev/null 2>&1") != 0) return;
+  const std::string cmd = "ffmpeg -loglevel error -y -framerate 30 -pattern_type glob -i '" + dir_.string() +
+                          "/frame_*.png' -c:v libx264 -pix_fmt yuv420p '" + dir_.string() + "/frames.mp4'";
+  if (std::system(cmd.c_str()) == 0) movie_ = "frames.mp4";
+}
+
+nlohmann::json FrameWriter::manifest() const {
+  nlohmann::json j = {{"frames", frames_},
+                      {"every_steps", every_},
+                      {"size", {r_.width(), r_.height()}},
+                      {"render_ms_median", median(draw_ms_)},
+                      {"render_timing", r_.timing_method()}};
+  if (!movie_.empty()) j["movie"] = movie_;
+  return j;
+}
+
+nlohmann::json context_manifest() {
+  if (!context_created()) return nullptr;
+  const ContextInfo& c = context();
+  return {{"vendor", c.vendor}, {"renderer", c.renderer}, {"version", c.version}, {"platform", c.platform}};
+}
+
+}  // namespace deformlab::gl

@@ -1,0 +1,23 @@
+#version 430 core
+// The largest displacement of the last step: max over nodes of velocity.w (non-negative,
+// +inf flags a non-finite node), reduced per work group, then one atomicMax on the bits
+// (non-negative floats order like their bit patterns).
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Vel { vec4 vel[]; };
+layout(std430, binding = 1) buffer Result { uint max_bits; };
+uniform int u_n;
+shared uint part[256];
+
+void main() {
+  uint l = gl_LocalInvocationID.x;
+  uint m = 0u;
+  for (uint j = gl_GlobalInvocationID.x; j < uint(u_n); j += gl_NumWorkGroups.x * 256u)
+    m = max(m, floatBitsToUint(vel[j].w));
+  part[l] = m;
+  barrier();
+  for (uint s = 128u; s > 0u; s >>= 1) {
+    if (l < s) part[l] = max(part[l], part[l + s]);
+    barrier();
+  }
+  if (l == 0u) atomicMax(max_bits, part[0]);
+}

@@ -1,0 +1,24 @@
+// Helpers for the GL tests: skip only where no GL context can be made at all.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "core/pipeline.hpp"
+#include "glsl_tf/context.hpp"
+#include "glsl_tf/pipelines_internal.hpp"
+
+#define DEFORMLAB_REQUIRE_GL()                                                \
+  do {                                                                        \
+    if (const std::string why = ::deformlab::gl::unavailable_reason(); !why.empty()) \
+      GTEST_SKIP() << why;                                                    \
+  } while (0)
+
+namespace deformlab::test {
+
+inline std::unique_ptr<Pipeline> make_gl(const std::string& name, const PipelineSetup& s) {
+  return name == "glsl-tf" ? gl::make_tf_pipeline(s) : gl::make_compute_pipeline(s);
+}
+
+}  // namespace deformlab::test
