@@ -17,7 +17,15 @@ struct RunArgs {
   std::optional<std::string> out;
 };
 
+struct ExperimentArgs {
+  std::vector<std::string> argv;
+  std::string file;  // a path, or the name of a built-in experiment (table1, quick, ...)
+  std::optional<std::string> out;
+  bool report_only = false;
+};
+
 int run_command(const RunArgs& a);
+int experiment_command(const ExperimentArgs& a);
 int list_command();
 
 }  // namespace deformlab::app

@@ -27,6 +27,14 @@ int main(int argc, char** argv) {
   run->add_option("--compare", a.compare, "Also run the double-precision reference ('cpu') and report the error");
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
 
+  deformlab::app::ExperimentArgs ex;
+  ex.argv = a.argv;
+  auto* experiment = cli.add_subcommand("experiment", "Run an experiment's sweep (resumable) and write its report");
+  experiment->add_option("file", ex.file, "Experiment file, or a built-in name (table1, table2, table3, interop, tiles, swap, quick)")
+      ->required();
+  experiment->add_option("--out,-o", ex.out, "Results folder (default: runs/<experiment name>)");
+  experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
+
   auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");
 
   try {
@@ -40,6 +48,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (*run) return deformlab::app::run_command(a);
+  if (*experiment) return deformlab::app::experiment_command(ex);
   if (*list) return deformlab::app::list_command();
   return 2;
 }

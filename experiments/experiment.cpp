@@ -20,6 +20,15 @@ Experiment parse_experiment(const std::string& text, const std::string& where) {
   }
   if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
   Experiment x;
+  // "base": start from another built-in experiment's scene and settings.
+  if (j.contains("base")) {
+    if (!j["base"].is_string()) throw std::invalid_argument(where + ".base: expected an experiment name");
+    const Experiment b = load_experiment_by_name(j["base"].get<std::string>());
+    x.pipeline = b.pipeline;
+    x.integrator = b.integrator;
+    x.until_converged = b.until_converged;
+    x.scene = b.scene;
+  }
   for (const auto& [k, v] : j.items()) {
     auto str = [&, &v = v, &k = k] {
       if (!v.is_string()) throw std::invalid_argument(where + "." + k + ": expected a string");
@@ -33,11 +42,13 @@ Experiment parse_experiment(const std::string& text, const std::string& where) {
       if (!v.is_boolean()) throw std::invalid_argument(where + ".until_converged: expected true or false");
       x.until_converged = v.get<bool>();
     } else if (k == "scene") apply_json(x.scene, v, where + ".scene");
+    else if (k == "sweep" || k == "base") continue;  // read by parse_sweep / above
     else
       throw std::invalid_argument(where + "." + k +
                                   ": unknown key (expected name, description, pipeline, integrator, "
-                                  "until_converged, scene)");
+                                  "until_converged, base, scene, sweep)");
   }
+  x.raw = j;
   return x;
 }
 
@@ -47,6 +58,13 @@ Experiment load_experiment(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_experiment(ss.str(), path);
+}
+
+Experiment load_experiment_by_name(const std::string& path_or_name) {
+  if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos)
+    if (const auto text = experiment_files::find(path_or_name + ".json"))
+      return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json");
+  return load_experiment(path_or_name);
 }
 
 Experiment default_experiment() {

@@ -1,5 +1,6 @@
 // An experiment file: a scene plus how to run it (pipeline, integrator, stop rule).
 #pragma once
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/scene.hpp"
@@ -13,11 +14,14 @@ struct Experiment {
   std::string integrator = "semi-implicit-euler";
   bool until_converged = true;
   Scene scene;
+  nlohmann::json raw;  // the whole file, for parts read elsewhere (the sweep) and manifests
 };
 
 // Parses experiment JSON text; `where` names it in errors (file name or "built-in ...").
 Experiment parse_experiment(const std::string& text, const std::string& where);
 Experiment load_experiment(const std::string& path);
+// A path to an experiment file, or the name of one built into the binary ("table1").
+Experiment load_experiment_by_name(const std::string& path_or_name);
 // The built-in experiment that `deformlab run` runs with no arguments (experiments/paper-drag.json).
 Experiment default_experiment();
 

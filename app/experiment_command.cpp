@@ -1,0 +1,58 @@
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+
+#include "commands.hpp"
+#include "experiments/experiment.hpp"
+#include "experiments/report.hpp"
+#include "experiments/sweep.hpp"
+
+namespace deformlab::app {
+
+int experiment_command(const ExperimentArgs& a) {
+  Experiment x;
+  std::optional<Sweep> sweep;
+  try {
+    x = load_experiment_by_name(a.file);
+    sweep = parse_sweep(x.raw, a.file);
+    if (!sweep) throw std::invalid_argument(a.file + ": has no \"sweep\" (run it with `deformlab run --experiment`)");
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 2;
+  }
+  const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
+  try {
+    if (!a.report_only) {
+      std::cout << "deformlab experiment " << x.name << ": " << cells(*sweep).size() << " cells into "
+                << dir.string() << " (cells already there are kept)\n";
+      SweepOptions o;
+      o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
+        const int ran = p.done - p.skipped;
+        const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0;
+        std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.size
+                  << "²";
+        for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
+        if (r["status"] == "ok")
+          std::cout << ": " << std::setprecision(4) << r["median_ms"].get<double>() << " ms/step";
+        else
+          std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
+        std::cout << std::setprecision(3) << "  [" << p.elapsed_s << " s, about " << std::ceil(left) << " s left]"
+                  << std::endl;
+      };
+      nlohmann::json command = a.argv;
+      const int ran = run_sweep(x, *sweep, dir, o, command);
+      std::cout << "ran " << ran << " cells\n";
+    }
+    std::cout << "report: " << write_report(dir).string() << "\n";
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace deformlab::app

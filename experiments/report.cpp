@@ -1,0 +1,217 @@
+#include "report.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "paper.hpp"
+#include "plot.hpp"
+#include "sweep.hpp"
+
+namespace deformlab {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  if (v >= 100) os << std::fixed << std::setprecision(1) << v;
+  else if (v >= 1) os << std::fixed << std::setprecision(3) << v;
+  else os << std::setprecision(3) << v;
+  return os.str();
+}
+
+std::string options_label(const json& o) {
+  std::string s;
+  for (const auto& [k, v] : o.items()) s += (s.empty() ? "" : ", ") + k + "=" + v.get<std::string>();
+  return s;
+}
+
+struct Column {
+  std::string label, pipeline, integrator;
+  json options;
+};
+
+// One table: rows are sizes, columns ours (then the paper's), grouped by one key.
+struct Table {
+  std::string title;
+  std::vector<Column> columns;
+};
+
+}  // namespace
+
+fs::path write_report(const fs::path& dir) {
+  std::ifstream min(dir / "manifest.json");
+  if (!min) throw std::invalid_argument("no manifest.json in " + dir.string());
+  const json manifest = json::parse(min);
+  const json& xj = manifest["experiment"];
+  const Sweep sweep = *parse_sweep(xj, "manifest.experiment");
+  const auto cells = load_cells(dir);
+  const std::string table = sweep.paper_table;
+  const bool by_pipeline = table == "table3";
+
+  // Results indexed by (pipeline, integrator, options, size).
+  std::map<std::string, const json*> at;
+  auto key = [](const std::string& p, const std::string& i, const json& o, int n) {
+    return p + "|" + i + "|" + o.dump() + "|" + std::to_string(n);
+  };
+  std::set<int> sizes;
+  for (const auto& c : cells) {
+    at[key(c["pipeline"], c["integrator"], c["options"], c["size"])] = &c;
+    sizes.insert(c["size"].get<int>());
+  }
+
+  // Columns in sweep order, grouped.
+  std::vector<Table> tables;
+  auto table_for = [&](const std::string& title) -> Table& {
+    for (auto& t : tables)
+      if (t.title == title) return t;
+    tables.push_back({title, {}});
+    return tables.back();
+  };
+  for (const auto& c : deformlab::cells(sweep)) {
+    Table& t = table_for(by_pipeline ? c.pipeline : c.integrator);
+    const json o = c.options;
+    std::string label = by_pipeline ? c.integrator : c.pipeline;
+    if (!o.empty()) label += " [" + options_label(o) + "]";
+    bool seen = false;
+    for (const auto& col : t.columns) seen |= col.label == label;
+    if (!seen) t.columns.push_back({label, c.pipeline, c.integrator, o});
+  }
+
+  std::ostringstream md;
+  const std::string name = xj.value("name", std::string("experiment"));
+  md << "# " << name << "\n\n" << xj.value("description", std::string()) << "\n\n";
+  const json& m = manifest["machine"];
+  md << "- Machine: " << m.value("cpu", std::string("?")) << ", " << m.value("hardware_threads", 0)
+     << " hardware threads, " << m.value("os", std::string("?")) << "\n";
+  md << "- Build: deformlab " << manifest["build"].value("deformlab", std::string()) << " ("
+     << manifest["build"].value("git", std::string()) << "), " << manifest["build"].value("compiler", std::string())
+     << ", CUDA " << manifest["build"].value("cuda", std::string()) << "\n";
+  for (const auto& [p, status] : manifest["pipelines"].items())
+    if (status != "available") md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
+  md << "- Method: ";
+  for (const auto& c : cells)
+    if (c["status"] == "ok") {
+      md << c["method"].get<std::string>() << ". Times are milliseconds per simulation step (update only";
+      md << "); the paper's are milliseconds per frame, update and rendering.\n";
+      break;
+    }
+  md << "\n";
+
+  // Footnotes for cells not measured, one per distinct reason, listing where it applies.
+  std::vector<std::pair<std::string, std::vector<std::string>>> notes;
+  auto note = [&](const std::string& reason, const std::string& where) {
+    for (std::size_t k = 0; k < notes.size(); ++k)
+      if (notes[k].first == reason) {
+        notes[k].second.push_back(where);
+        return k + 1;
+      }
+    notes.push_back({reason, {where}});
+    return notes.size();
+  };
+  std::vector<std::string> reading;
+  for (const auto& t : tables) {
+    md << "## " << (by_pipeline ? "Pipeline " : "Integrator ") << "`" << t.title << "`\n\n";
+    std::vector<paper::Column> pcols;
+    for (const auto& pc : paper::columns(table))
+      if ((by_pipeline ? pc.pipeline : pc.integrator) == t.title) pcols.push_back(pc);
+    std::vector<paper::Ratio> rats;
+    auto ours = [&](const std::string& pipe, const std::string& integ, const json& o, int n) -> const json* {
+      const auto it = at.find(key(pipe, integ, o, n));
+      return it == at.end() || (*it->second)["status"] != "ok" ? nullptr : it->second;
+    };
+    auto has_col = [&](const std::string& p) {
+      for (const auto& c : t.columns)
+        if (c.pipeline == p && c.options.empty()) return true;
+      return false;
+    };
+    for (const auto& r : paper::ratios(table))
+      if (!by_pipeline && has_col(r.num) && has_col(r.den)) rats.push_back(r);
+
+    md << "| grid | nodes |";
+    for (const auto& c : t.columns) md << " " << c.label << " |";
+    for (const auto& pc : pcols) md << " " << pc.label << " |";
+    for (const auto& r : rats) md << " " << r.label << " | paper " << r.label << " |";
+    md << "\n|---|---|";
+    for (std::size_t k = 0; k < t.columns.size() + pcols.size() + 2 * rats.size(); ++k) md << "---|";
+    md << "\n";
+    std::vector<plot::Series> series;
+    for (const auto& c : t.columns) series.push_back({c.label, {}, {}, false});
+    for (const auto& pc : pcols) series.push_back({pc.label, {}, {}, true});
+    for (int n : sizes) {
+      const double nodes = sweep.sizes.empty() ? 0 : double(n) * n;
+      md << "| " << n << "² | " << std::int64_t(nodes) << " |";
+      for (std::size_t k = 0; k < t.columns.size(); ++k) {
+        const auto& c = t.columns[k];
+        const auto it = at.find(key(c.pipeline, c.integrator, c.options, n));
+        if (it == at.end()) {
+          md << " - |";
+          continue;
+        }
+        const json& r = *it->second;
+        if (r["status"] == "ok") {
+          md << " " << fmt(r["median_ms"]) << " |";
+          series[k].x.push_back(r["nodes"].get<double>());
+          series[k].y.push_back(r["median_ms"].get<double>());
+        } else {
+          md << " n/a [" << note(r["reason"], c.label + " " + std::to_string(n) + "²") << "] |";
+        }
+      }
+      for (std::size_t k = 0; k < pcols.size(); ++k) {
+        const auto f = paper::figure(table, pcols[k], n);
+        md << " " << (f ? fmt(*f) : "n/a") << " |";
+        if (f) {
+          series[t.columns.size() + k].x.push_back(nodes);
+          series[t.columns.size() + k].y.push_back(*f);
+        }
+      }
+      for (const auto& r : rats) {
+        const json* a = ours(r.num, t.title, json::object(), n);
+        const json* b = ours(r.den, t.title, json::object(), n);
+        std::optional<double> pa, pb;
+        for (const auto& pc : paper::columns(table)) {
+          if (pc.pipeline == r.num) pa = paper::figure(table, pc, n);
+          if (pc.pipeline == r.den) pb = paper::figure(table, pc, n);
+        }
+        const bool here = a && b, there = pa && pb;
+        const double q = here ? (*a)["median_ms"].get<double>() / (*b)["median_ms"].get<double>() : 0;
+        const double pq = there ? *pa / *pb : 0;
+        md << " " << (here ? fmt(q) : "n/a") << " | " << (there ? fmt(pq) : "n/a") << " |";
+        if (here && there)
+          reading.push_back(r.label + " (" + r.num + " / " + r.den + ") at " + std::to_string(n) + "²: paper " + fmt(pq) +
+                            ", here " + fmt(q) + ": " +
+                            ((pq > 1) == (q > 1) ? "the paper's ordering holds"
+                                                 : "the ordering reverses (" +
+                                                       (q > 1 ? r.den + " is faster here" : r.num + " is faster here") + ")"));
+      }
+      md << "\n";
+    }
+    const std::string svg = "plot-" + t.title + ".svg";
+    plot::loglog(dir / svg, name + ": " + t.title, "nodes", "ms per step (dashed: paper, ms per frame)", series);
+    md << "\n![" << t.title << "](" << svg << ")\n\n";
+  }
+  if (!notes.empty()) {
+    md << "## Cells not measured\n\n";
+    for (std::size_t k = 0; k < notes.size(); ++k) {
+      md << "[" << k + 1 << "] " << notes[k].first << " (";
+      for (std::size_t w = 0; w < notes[k].second.size(); ++w) md << (w ? ", " : "") << notes[k].second[w];
+      md << ")\n\n";
+    }
+  }
+  if (!reading.empty()) {
+    md << "## Reading against the paper\n\n";
+    for (const auto& r : reading) md << "- " << r << "\n";
+    md << "\n";
+  }
+  write_atomically(dir / "report.md", md.str());
+  return dir / "report.md";
+}
+
+}  // namespace deformlab

@@ -1,0 +1,256 @@
+#include "sweep.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+#include "core/state.hpp"
+#include "output.hpp"
+#include "pipelines.hpp"
+
+namespace deformlab {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string Cell::id() const {
+  std::string s = pipeline + "__" + integrator + "__" + std::to_string(size);
+  for (const auto& [k, v] : options) s += "__" + k + "-" + v;
+  for (char& ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
+  return s;
+}
+
+namespace {
+
+[[noreturn]] void bad(const std::string& where, const std::string& what) {
+  throw std::invalid_argument(where + ": " + what);
+}
+
+std::vector<std::string> strings(const json& j, const std::string& where) {
+  if (!j.is_array() || j.empty()) bad(where, "expected a non-empty list of names");
+  std::vector<std::string> out;
+  for (const auto& e : j) {
+    if (!e.is_string()) bad(where, "expected a list of names");
+    out.push_back(e.get<std::string>());
+  }
+  return out;
+}
+
+int positive(const json& j, const std::string& where) {
+  if (!j.is_number_integer() || j.get<std::int64_t>() < 1 || j.get<std::int64_t>() > 1'000'000)
+    bad(where, "expected a positive integer");
+  return j.get<int>();
+}
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
+  if (!x.contains("sweep")) return std::nullopt;
+  const json& j = x["sweep"];
+  const std::string w = where + ".sweep";
+  if (!j.is_object()) bad(w, "expected an object");
+  Sweep s;
+  for (const auto& [k, v] : j.items()) {
+    if (k == "sizes") {
+      if (!v.is_array() || v.empty()) bad(w + ".sizes", "expected a non-empty list of sizes");
+      for (const auto& n : v) s.sizes.push_back(positive(n, w + ".sizes"));
+    } else if (k == "pipelines") s.pipelines = strings(v, w + ".pipelines");
+    else if (k == "integrators") s.integrators = strings(v, w + ".integrators");
+    else if (k == "options") {
+      if (!v.is_array() || v.empty()) bad(w + ".options", "expected a non-empty list of option objects");
+      for (const auto& o : v) {
+        if (!o.is_object()) bad(w + ".options", "expected objects of NAME: \"VALUE\"");
+        PipelineOptions po;
+        for (const auto& [name, value] : o.items()) {
+          if (!value.is_string()) bad(w + ".options." + name, "expected a string value");
+          po[name] = value.get<std::string>();
+        }
+        s.option_sets.push_back(po);
+      }
+    } else if (k == "warmup") s.warmup = positive(v, w + ".warmup");
+    else if (k == "steps") s.steps = positive(v, w + ".steps");
+    else if (k == "repetitions") s.repetitions = positive(v, w + ".repetitions");
+    else if (k == "cell_limit_s") {
+      if (!v.is_number() || !(v.get<double>() > 0)) bad(w + ".cell_limit_s", "expected a positive number");
+      s.cell_limit_s = v.get<double>();
+    } else if (k == "time") {
+      if (v != "update") bad(w + ".time", "expected \"update\" (rendered frames are not timed by sweeps yet)");
+      s.time = v.get<std::string>();
+    } else if (k == "paper_table") {
+      if (v != "table1" && v != "table2" && v != "table3" && v != "")
+        bad(w + ".paper_table", "expected \"table1\", \"table2\" or \"table3\"");
+      s.paper_table = v.get<std::string>();
+    } else
+      bad(w + "." + k, "unknown key (expected sizes, pipelines, integrators, options, warmup, steps, "
+                       "repetitions, cell_limit_s, time, paper_table)");
+  }
+  if (s.sizes.empty()) bad(w, "needs sizes");
+  if (s.pipelines.empty()) bad(w, "needs pipelines");
+  if (s.integrators.empty()) s.integrators = {x.value("integrator", std::string("semi-implicit-euler"))};
+  if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};
+  for (const auto& p : s.pipelines)
+    if (!pipelines().find(p)) bad(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
+  for (const auto& i : s.integrators)
+    if (!parse_integrator(i)) bad(w + ".integrators", "unknown integrator '" + i + "' (valid: " + integrator_names() + ")");
+  return s;
+}
+
+std::vector<Cell> cells(const Sweep& s) {
+  std::vector<Cell> out;
+  for (const auto& integ : s.integrators)
+    for (const auto& pipe : s.pipelines) {
+      // A pipeline runs the option sets whose every name it reads; with none, it runs once.
+      const auto& accepted = pipelines().find(pipe)->options;
+      std::vector<PipelineOptions> sets;
+      for (const auto& o : s.option_sets)
+        if (std::all_of(o.begin(), o.end(), [&](const auto& kv) {
+              return std::find(accepted.begin(), accepted.end(), kv.first) != accepted.end();
+            }) && (!o.empty() || sets.empty()))
+          sets.push_back(o);
+      if (sets.empty()) sets.push_back({});
+      for (const auto& o : sets)
+        for (int n : s.sizes) out.push_back({n, pipe, integ, o});
+    }
+  return out;
+}
+
+json run_cell(const Experiment& x, const Sweep& s, const Cell& c) {
+  using clock = std::chrono::steady_clock;
+  json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
+            {"options", c.options}};
+  auto na = [&](const std::string& why) {
+    r["status"] = "n/a";
+    r["reason"] = why;
+    return r;
+  };
+  const PipelineEntry& e = *pipelines().find(c.pipeline);
+  const Integrator integ = *parse_integrator(c.integrator);
+  if (auto why = e.unavailable(); !why.empty()) return na(why);
+  if (auto why = e.unsupported(integ); !why.empty()) return na(why);
+
+  Scene scene = x.scene;
+  ModelSpec& ms = scene.model;
+  ms.nx = ms.ny = c.size;
+  ms.nz = ms.topology == Topology::lattice ? c.size : 1;
+  const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
+                                                  : cloth_spring_counts(ms.nx, ms.ny);
+  const std::int64_t nodes = std::int64_t(ms.nx) * ms.ny * ms.nz, springs = k[0] + k[1] + k[2];
+  r["nodes"] = nodes;
+  r["springs"] = springs;
+  const std::int64_t need = model_bytes(nodes, springs), have = available_memory_bytes();
+  if (nodes > (std::int64_t(1) << 30) || (have > 0 && need > have))
+    return na("does not fit: needs about " + std::to_string(need >> 20) + " MiB of host memory, " +
+              std::to_string(have >> 20) + " MiB available");
+  try {
+    const Model m = build_model(scene);
+    const Params p = resolve_params(scene, m);
+    auto pipe = e.make({m, p, integ, c.options});
+    pipe->set_state(rest_state(m));
+    // One step first: it bounds the cell's time before committing to it.
+    const auto t0 = clock::now();
+    pipe->step();
+    pipe->max_displacement();
+    const double first_s = std::chrono::duration<double>(clock::now() - t0).count();
+    const double expect_s = first_s * (s.warmup + double(s.steps) * s.repetitions);
+    if (expect_s > s.cell_limit_s) {
+      std::ostringstream os;
+      os << "cut: the first step took " << first_s << " s, the cell would need about " << expect_s
+         << " s, over its limit of " << s.cell_limit_s << " s";
+      return na(os.str());
+    }
+    for (int w = 1; w < s.warmup; ++w) pipe->step();
+    pipe->max_displacement();
+    std::vector<double> ms_per_step;
+    for (int rep = 0; rep < s.repetitions; ++rep) {
+      const auto b0 = clock::now();
+      for (int st = 0; st < s.steps; ++st) pipe->step();
+      pipe->max_displacement();  // waits for the device's last step
+      ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
+    }
+    const double d = pipe->max_displacement();
+    r["status"] = "ok";
+    r["median_ms"] = median_of(ms_per_step);
+    r["min_ms"] = *std::min_element(ms_per_step.begin(), ms_per_step.end());
+    r["samples_ms"] = ms_per_step;
+    r["stable"] = d == d;
+    r["pipeline_timing"] = pipe->timing_method();
+    r["method"] = "host steady_clock around " + std::to_string(s.steps) +
+                  " steps closed by the pipeline's max-displacement reduction (which waits for the device), "
+                  "ms per step, median of " + std::to_string(s.repetitions) + " batches after " +
+                  std::to_string(s.warmup) + " warm-up steps";
+    return r;
+  } catch (const std::invalid_argument& ex) {
+    return na(ex.what());
+  } catch (const std::bad_alloc&) {
+    return na("does not fit: out of host memory");
+  }
+}
+
+void write_atomically(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, file);
+}
+
+std::vector<json> load_cells(const fs::path& dir) {
+  std::vector<json> out;
+  if (!fs::is_directory(dir / "cells")) return out;
+  std::vector<fs::path> files;
+  for (const auto& f : fs::directory_iterator(dir / "cells"))
+    if (f.path().extension() == ".json") files.push_back(f.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    out.push_back(json::parse(in));
+  }
+  return out;
+}
+
+int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
+  using clock = std::chrono::steady_clock;
+  fs::create_directories(dir / "cells");
+  json manifest = {{"experiment", x.raw}, {"command", command}, {"build", build_info()}, {"machine", machine_info()}};
+  json devices = json::object();
+  for (const auto& p : s.pipelines)
+    if (const auto* e = pipelines().find(p)) devices[p] = e->unavailable().empty() ? "available" : e->unavailable();
+  manifest["pipelines"] = devices;
+  write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
+
+  const auto all = cells(s);
+  SweepProgress prog;
+  prog.total = int(all.size());
+  const auto start = clock::now();
+  int ran = 0;
+  for (const auto& c : all) {
+    const fs::path file = dir / "cells" / (c.id() + ".json");
+    json r;
+    if (fs::exists(file)) {
+      std::ifstream in(file);
+      r = json::parse(in);
+      ++prog.skipped;
+    } else {
+      r = run_cell(x, s, c);
+      write_atomically(file, r.dump(2) + "\n");
+      ++ran;
+    }
+    ++prog.done;
+    prog.elapsed_s = std::chrono::duration<double>(clock::now() - start).count();
+    if (o.on_cell) o.on_cell(c, r, prog);
+  }
+  return ran;
+}
+
+}  // namespace deformlab
