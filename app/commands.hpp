@@ -1,6 +1,7 @@
 // The deformlab subcommands. Each returns the process exit code: 0 success, 1 a run that
 // failed (divergence, a backend error), 2 bad input (nothing written).
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,10 @@ struct ExperimentArgs {
   std::optional<std::string> out;
   bool report_only = false;
 };
+
+// Runs `body`, turning an exception into one line on stderr and an exit code: 2 for
+// std::invalid_argument (bad input), 1 for anything else.
+int report_errors(const std::function<int()>& body);
 
 int run_command(const RunArgs& a);
 int experiment_command(const ExperimentArgs& a);

@@ -22,7 +22,7 @@ int experiment_command(const ExperimentArgs& a) {
     return 2;
   }
   const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
-  try {
+  return report_errors([&] {
     if (!a.report_only) {
       std::cout << "deformlab experiment " << x.name << ": " << cells(*sweep).size() << " cells into "
                 << dir.string() << " (cells already there are kept)\n";
@@ -46,13 +46,7 @@ int experiment_command(const ExperimentArgs& a) {
     }
     std::cout << "report: " << write_report(dir).string() << "\n";
     return 0;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace deformlab::app

@@ -4,6 +4,22 @@
 
 #include "commands.hpp"
 
+namespace deformlab::app {
+
+int report_errors(const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace deformlab::app
+
 int main(int argc, char** argv) {
   using deformlab::app::RunArgs;
   CLI::App cli{"deformlab: mass-spring deformation on CPU, CUDA and GLSL pipelines"};

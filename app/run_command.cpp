@@ -144,7 +144,7 @@ int run_command(const RunArgs& a) {
   }
 
   // 2. Run, writing into a staging folder that is committed only on success.
-  try {
+  return report_errors([&] {
     const std::string out = a.out ? *a.out : "runs/" + (x.name.empty() ? std::string("run") : x.name);
     OutputDir dir(out);
     auto pipe = entry->make({model, params, integ, options});
@@ -212,16 +212,7 @@ int run_command(const RunArgs& a) {
                 << " of the model's extent\n";
     std::cout << "  wrote " << dir.dir().string() << "/{timings.csv, state.ply, manifest.json}\n";
     return 0;
-  } catch (const DivergenceError& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
-    return 1;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace deformlab::app
