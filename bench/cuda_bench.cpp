@@ -1,0 +1,216 @@
+// `deformlab-bench cuda`: ms per step of the CUDA pipelines on cloth grids, against the
+// device's own copy bandwidth; launch overhead with and without step graphs; tile shapes.
+#include <algorithm>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "bench.hpp"
+#include "core/state.hpp"
+#include "cuda_kernels/cuda_pipeline.hpp"
+
+namespace deformlab::bench {
+
+namespace {
+
+struct CudaOptions {
+  std::vector<int> sizes{64, 128, 256, 512, 1024, 2048, 4096, 8192};
+  std::vector<std::string> variants{"naive", "tiled", "scatter", "fused"};
+  std::string integrator = "verlet";
+  std::vector<std::string> tiles{"8x8", "16x8", "16x16", "32x4", "32x8", "32x16", "64x4", "128x2", "256x1"};
+  int tile_size = 2048;
+  std::vector<int> graph_sizes{64, 128, 256, 512};
+  int warmup = 10, batches = 15;
+  int copy_mib = 1024;
+  double reference_ms = 0.48;
+  std::string csv;
+};
+
+cuda::Variant parse_variant(const std::string& s) {
+  for (cuda::Variant v : {cuda::Variant::naive, cuda::Variant::tiled, cuda::Variant::scatter, cuda::Variant::fused})
+    if (s == cuda::to_string(v)) return v;
+  throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused)");
+}
+
+Integrator parse(const std::string& s) {
+  const auto i = parse_integrator(s);
+  if (!i) throw std::invalid_argument("unknown integrator " + s);
+  return *i;
+}
+
+Model bench_cloth(int n) {
+  Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
+  pin(m, pin_nodes(m, PinSet::top_corners, {}));
+  return m;
+}
+
+Params bench_params() {
+  Params p;
+  p.dt = 0.001f;  // under the stability limit of these grids for the symplectic schemes
+  return p;
+}
+
+// Median ms per step from the rest state: warm-up steps, then `batches` batches timed by
+// CUDA events, each long enough to last about a millisecond (3 to 100 steps).
+Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, int warmup, int batches) {
+  p.set_state(rest_state(m));
+  const double warm = p.timed_steps(warmup) / warmup;
+  const int steps = std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100);
+  std::vector<double> ms;
+  for (int b = 0; b < batches; ++b) ms.push_back(p.timed_steps(steps) / steps);
+  return stats(ms);
+}
+
+struct Row {
+  std::string table, grid, variant, integrator, tile;
+  bool graphs;
+  std::int64_t nodes;
+  double ms, floor_bytes, gbs, of_copy;
+};
+
+class Report {
+ public:
+  Report(const CudaOptions& o, double copy_gbs) : copy_gbs_(copy_gbs) {
+    if (!o.csv.empty()) {
+      csv_.open(o.csv);
+      if (!csv_) throw std::invalid_argument("cannot write " + o.csv);
+      csv_ << "table,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,effective_GBps,"
+              "fraction_of_copy\n";
+    }
+  }
+  Row measure(const std::string& table, const Model& m, Integrator integ, const cuda::Options& opt, const CudaOptions& o) {
+    auto p = cuda::make_pipeline({m, bench_params(), integ}, opt);
+    const Stats st = ms_per_step(*p, m, o.warmup, o.batches);
+    Row r;
+    r.table = table;
+    r.grid = std::to_string(m.nx) + "^2";
+    r.variant = cuda::to_string(opt.variant);
+    r.integrator = std::string(info(integ).name);
+    r.tile = std::to_string(opt.tile.x) + "x" + std::to_string(opt.tile.y);
+    r.graphs = opt.graphs;
+    r.nodes = m.node_count();
+    r.ms = st.median;
+    r.floor_bytes = cuda::floor_bytes_per_node(m, integ, opt.variant);
+    r.gbs = r.floor_bytes * double(r.nodes) / (r.ms * 1e-3) / 1e9;
+    r.of_copy = r.gbs / copy_gbs_;
+    if (csv_)
+      csv_ << r.table << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator << "," << r.tile
+           << "," << r.graphs << "," << r.ms << "," << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
+    return r;
+  }
+
+ private:
+  double copy_gbs_;
+  std::ofstream csv_;
+};
+
+std::string fixed(double v, int prec) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(prec) << v;
+  return s.str();
+}
+
+void run_cuda(const CudaOptions& o) {
+  if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
+  const Integrator integ = parse(o.integrator);
+  std::vector<cuda::Variant> variants;
+  for (const auto& v : o.variants) variants.push_back(parse_variant(v));
+
+  const cuda::DeviceInfo dev = cuda::device_info();
+  const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
+  const double copy = cuda::copy_ms(copy_bytes, 20);
+  const double copy_gbs = 2.0 * double(copy_bytes) / (copy * 1e-3) / 1e9;
+  std::cout << "deformlab-bench cuda: " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
+            << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
+            << dev.runtime_version << "\n"
+            << "method: CUDA events around batches of steps (each batch about 1 ms, 3..100 steps) after " << o.warmup
+            << " warm-up steps; median of " << o.batches << " batches, in ms per step.\n"
+            << "cloth grid n x n, 12 springs per interior node, top corners pinned, dt 1 ms, from rest.\n"
+            << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
+            << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
+            << "device of " << o.copy_mib << " MiB, " << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
+            << " GB/s counting read + write (the memory ceiling of this run).\n";
+
+  Report rep(o, copy_gbs);
+  std::cout << "\n[steps] " << o.integrator << ", tile 32x8, step graphs on\n"
+            << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
+            << "B/node" << std::setw(10) << "GB/s" << std::setw(10) << "of copy" << "\n";
+  for (int n : o.sizes) {
+    const Model m = bench_cloth(n);
+    for (cuda::Variant v : variants) {
+      const Row r = rep.measure("steps", m, integ, {v, {}, true}, o);
+      std::cout << std::setw(8) << r.grid << std::setw(10) << r.variant << std::setw(12) << fixed(r.ms, 4)
+                << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(10) << fixed(r.gbs, 0) << std::setw(9)
+                << fixed(100 * r.of_copy, 1) << "%\n";
+    }
+  }
+
+  std::cout << "\n[graphs] launch overhead: ms/step with and without the step captured as a CUDA graph ("
+            << o.integrator << ")\n"
+            << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "graph" << std::setw(12)
+            << "launches" << std::setw(10) << "gain" << "\n";
+  for (int n : o.graph_sizes) {
+    const Model m = bench_cloth(n);
+    for (cuda::Variant v : {cuda::Variant::fused, cuda::Variant::naive}) {
+      const Row g = rep.measure("graphs", m, integ, {v, {}, true}, o);
+      const Row l = rep.measure("graphs", m, integ, {v, {}, false}, o);
+      std::cout << std::setw(8) << g.grid << std::setw(10) << g.variant << std::setw(12) << fixed(g.ms, 4)
+                << std::setw(12) << fixed(l.ms, 4) << std::setw(9) << fixed(l.ms / g.ms, 2) << "x\n";
+    }
+  }
+
+  if (o.tile_size > 0 && !o.tiles.empty()) {
+    std::cout << "\n[tiles] block shape sweep at " << o.tile_size << "^2 (" << o.integrator
+              << "): ms/step; tiled stages the block + 2-node halo in shared memory\n"
+              << std::setw(8) << "tile" << std::setw(12) << "tiled" << std::setw(12) << "naive" << std::setw(12)
+              << "fused" << "\n";
+    const Model m = bench_cloth(o.tile_size);
+    for (const auto& t : o.tiles) {
+      const cuda::Tile tile = cuda::parse_tile(t);
+      std::cout << std::setw(8) << t;
+      for (cuda::Variant v : {cuda::Variant::tiled, cuda::Variant::naive, cuda::Variant::fused})
+        std::cout << std::setw(12) << fixed(rep.measure("tiles", m, integ, {v, tile, true}, o).ms, 4);
+      std::cout << "\n";
+    }
+  }
+
+  if (o.tile_size > 0) {
+    std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 against the copy ceiling and the "
+              << "paper author's CUDA Verlet cloth kernel (" << o.reference_ms << " ms per step at 2048^2 on this "
+              << "machine type)\n"
+              << std::setw(22) << "integrator" << std::setw(12) << "ms/step" << std::setw(10) << "B/node"
+              << std::setw(10) << "of copy" << std::setw(14) << "vs reference" << "\n";
+    const Model m = bench_cloth(o.tile_size);
+    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet}) {
+      const Row r = rep.measure("fused", m, i, {cuda::Variant::fused, {}, true}, o);
+      std::cout << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4) << std::setw(10)
+                << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%" << std::setw(13)
+                << fixed(o.reference_ms / r.ms, 2) << "x\n";
+    }
+  }
+}
+
+}  // namespace
+
+void add_cuda_bench(CLI::App& app) {
+  auto o = std::make_shared<CudaOptions>();
+  auto* c = app.add_subcommand("cuda", "CUDA variants: ms/step at 64^2 to 8192^2 against the copy bandwidth, "
+                                       "step graphs, tile sweep");
+  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
+  c->add_option("--variants", o->variants, "Variants: naive, tiled, scatter, fused");
+  c->add_option("--integrator", o->integrator, "Integrator of the main table and the sweeps");
+  c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
+  c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
+  c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
+  c->add_option("--warmup", o->warmup, "Warm-up steps")->check(CLI::PositiveNumber);
+  c->add_option("--batches", o->batches, "Timed batches (the median is reported)")->check(CLI::PositiveNumber);
+  c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
+  c->add_option("--csv", o->csv, "Also write every measurement to this CSV file");
+  c->callback([o] { run_cuda(*o); });
+}
+
+}  // namespace deformlab::bench

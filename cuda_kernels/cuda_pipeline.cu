@@ -1,0 +1,539 @@
+// The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
+// and the device reductions (displacement, energy).
+#include <thrust/execution_policy.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "check.cuh"
+#include "cuda_pipeline.hpp"
+#include "kernels.cuh"
+
+namespace deformlab::cuda {
+namespace {
+
+using dev::Link;
+using dev::Scene;
+using dev::Spring;
+using dev::Stencil;
+using dev::Targets;
+
+constexpr int kBlock = 256;  // threads per block of the one-dimensional kernels
+
+unsigned blocks_for(std::int64_t n) { return unsigned((n + kBlock - 1) / kBlock); }
+
+// The stencil of a grid model in the CPU's adjacency order. Node v's springs are ordered by
+// spring index, and the builder numbers springs by their lower end (in node order), then by
+// the half-stencil offset. So v first sees the springs whose lower end is v - o (for each
+// half-stencil offset o, by decreasing linear offset), then its own in half-stencil order.
+// Rest lengths: one per offset, the model's value for the first spring with that offset.
+Stencil make_stencil(const Model& m) {
+  struct Half {
+    int di, dj, dk, kind;
+    std::int64_t linear;
+    float rest;
+  };
+  // Offsets keyed by (di, dj, dk) themselves: distinct offsets can share a linear offset on
+  // narrow grids. Scanning stops once every offset of the builder's half stencil was seen.
+  const bool volume = m.nz > 1 || m.topology == Topology::lattice;
+  const std::size_t possible = volume ? 16 : 6;
+  std::vector<Half> half;
+  std::vector<bool> seen(9 * 9 * 9, false);
+  const std::int64_t nxy = std::int64_t(m.nx) * m.ny;
+  for (int e = 0; e < m.spring_count() && half.size() < possible; ++e) {
+    const int a = m.spring_i[e], b = m.spring_j[e];
+    const int di = b % m.nx - a % m.nx, dj = int((b / m.nx) % m.ny - (a / m.nx) % m.ny), dk = int(b / nxy - a / nxy);
+    const int key = ((dk + 4) * 9 + dj + 4) * 9 + di + 4;
+    if (seen[key]) continue;
+    seen[key] = true;
+    half.push_back({di, dj, dk, int(m.kind[e]), std::int64_t(b) - a, m.rest_length[e]});
+  }
+  // Own springs in the builder's stencil order: lexicographic in (dk, dj, di) for the
+  // neighbour offsets, then flexion (2,0,0), (0,2,0), (0,0,2).
+  auto stencil_rank = [](const Half& h) {
+    const bool flex = std::abs(h.di) == 2 || std::abs(h.dj) == 2 || std::abs(h.dk) == 2;
+    if (flex) return 1000 + (h.di == 2 ? 0 : h.dj == 2 ? 1 : 2);
+    return ((h.dk + 1) * 3 + (h.dj + 1)) * 3 + (h.di + 1);
+  };
+  std::vector<Half> own = half, in = half;
+  std::stable_sort(own.begin(), own.end(), [&](const Half& a, const Half& b) { return stencil_rank(a) < stencil_rank(b); });
+  std::stable_sort(in.begin(), in.end(), [](const Half& a, const Half& b) { return a.linear > b.linear; });
+  Stencil st{};
+  auto put = [&](const Half& h, int sign) {
+    int& count = st.count;
+    if (count >= dev::kMaxStencil) throw std::logic_error("grid stencil larger than the kernels' limit");
+    st.di[count] = std::int8_t(sign * h.di);
+    st.dj[count] = std::int8_t(sign * h.dj);
+    st.dk[count] = std::int8_t(sign * h.dk);
+    st.kind[count] = std::uint8_t(h.kind);
+    st.rest[count] = h.rest;
+    ++count;
+  };
+  for (const auto& h : in) put(h, -1);
+  for (const auto& h : own) put(h, +1);
+  return st;
+}
+
+struct DispOp {  // |x_new - x_old|, +inf where anything is not finite
+  const float4* x;
+  const float4* x_old;
+  const float4* v;
+  __device__ float operator()(int i) const {
+    const float d = norm(dev::xyz(x[i]) - dev::xyz(x_old[i]));
+    const float4 w = v[i];
+    const bool finite = isfinite(d) && isfinite(w.x) && isfinite(w.y) && isfinite(w.z);
+    return finite ? d : INFINITY;
+  }
+};
+
+__host__ __device__ Vec3d widen(const Vec3f& a) { return {a.x, a.y, a.z}; }
+
+struct NodeEnergy {
+  double kinetic, field;
+};
+struct NodeEnergyOp {
+  const float4* x;
+  const float4* v;
+  Vec3d g, wind;
+  __device__ NodeEnergy operator()(int i) const {
+    const float4 x4 = x[i];
+    if (x4.w == 0.f) return {0.0, 0.0};
+    const double mass = 1.0 / x4.w;
+    const Vec3d vd = widen(dev::xyz(v[i])), xd = widen(dev::xyz(x4));
+    return {0.5 * mass * dot(vd, vd), -dot(g * mass + wind, xd)};
+  }
+};
+struct AddNodeEnergy {
+  __device__ NodeEnergy operator()(const NodeEnergy& a, const NodeEnergy& b) const {
+    return {a.kinetic + b.kinetic, a.field + b.field};
+  }
+};
+struct SpringEnergyOp {
+  const Spring* springs;
+  const float4* x;
+  double k[3];
+  __device__ double operator()(std::int64_t e) const {
+    const Spring s = springs[e];
+    const double stretch = norm(widen(dev::xyz(x[s.i])) - widen(dev::xyz(x[s.j]))) - s.rest;
+    return 0.5 * (s.kind == 0 ? k[0] : s.kind == 1 ? k[1] : k[2]) * stretch * stretch;
+  }
+};
+
+class Impl final : public CudaPipeline {
+ public:
+  Impl(const PipelineSetup& su, const Options& o)
+      : model_(su.model), p_(su.params), sched_(make_schedule(su.integrator)), o_(o) {
+    if (const std::string why = unsupported(su.integrator); !why.empty()) throw std::invalid_argument(why);
+    if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
+    validate(p_, model_.node_count());
+    const Model& m = model_;
+    n_ = m.node_count();
+    grid_ = m.topology != Topology::general;
+    if (o_.variant == Variant::tiled || grid_) check_tile(m);
+    fused_ = o_.variant == Variant::fused && sched_.single_pass();
+    require_device_memory(bytes_needed(m, su.integrator, o_),
+                          std::string("the cuda-") + to_string(o_.variant) + " pipeline for " + std::to_string(n_) +
+                              " nodes (" + std::string(info(su.integrator).name) + ")");
+
+    check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
+    check(cudaEventCreate(&ev_[0]), "creating a timing event");
+    check(cudaEventCreate(&ev_[1]), "creating a timing event");
+
+    scene_.n = n_;
+    scene_.nx = m.nx; scene_.ny = m.ny; scene_.nz = std::max(1, m.nz);
+    for (int k = 0; k < kSpringKinds; ++k) { scene_.k[k] = m.stiffness[k]; scene_.kd[k] = m.damping[k]; }
+    damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
+    scene_.gravity = p_.gravity; scene_.wind = p_.wind;
+    scene_.c = p_.damping; scene_.dt = p_.dt;
+    if (p_.drag.active()) {
+      scene_.drag_node = p_.drag.node;
+      scene_.drag_hard = !p_.drag.as_spring;
+      scene_.drag_k = p_.drag.stiffness;
+    }
+    scene_.has_ground = p_.ground.has_value();
+    scene_.ground = p_.ground.value_or(0.f);
+    if (!p_.spheres.empty()) {
+      std::vector<float4> sp;
+      for (const auto& s : p_.spheres) sp.push_back(make_float4(s.center.x, s.center.y, s.center.z, s.radius));
+      upload(spheres_, sp, "uploading the sphere colliders");
+      scene_.sphere_count = int(sp.size());
+      scene_.spheres = spheres_.get();
+    }
+
+    for (auto& b : x_) b.allocate(n_, "allocating positions");
+    for (auto& b : v_) b.allocate(n_, "allocating velocities");
+    for (int k = 0; k < sched_.stage_states; ++k) {
+      sx_[k].allocate(n_, "allocating stage positions");
+      sv_[k].allocate(n_, "allocating stage velocities");
+    }
+    if (!fused_)
+      for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
+
+    if (grid_) {
+      stencil_ = make_stencil(m);
+    } else if (o_.variant != Variant::scatter) {
+      std::vector<Link> links(m.adj_node.size());
+      for (std::size_t e = 0; e < links.size(); ++e) {
+        const int sp = m.adj_spring[e];
+        links[e] = {m.adj_node[e], int(m.kind[sp]), m.rest_length[sp], 0};
+      }
+      upload(offset_, m.adj_offset, "uploading the adjacency offsets");
+      upload(links_, links, "uploading the adjacency");
+    }
+    if (o_.variant == Variant::scatter) upload_springs();
+    set_state(rest_state(m));
+  }
+
+  ~Impl() override {
+    for (auto& g : graph_)
+      if (g) cudaGraphExecDestroy(g);
+    cudaEventDestroy(ev_[0]);
+    cudaEventDestroy(ev_[1]);
+    if (stream_) cudaStreamDestroy(stream_);
+  }
+
+  void set_state(const State& s) override {
+    if (s.x.size() != std::size_t(n_) || s.v.size() != std::size_t(n_) ||
+        (!s.x_prev.empty() && s.x_prev.size() != std::size_t(n_)))
+      throw std::invalid_argument("state size does not match the model");
+    cur_ = 0;
+    upload_positions(x_[0], s.x);
+    upload_vectors(v_[0], s.v);
+    has_prev_ = !s.x_prev.empty();
+    if (has_prev_) upload_positions(x_[1], s.x_prev);
+    t_ = s.t;
+    stepped_ = false;
+  }
+
+  State state() override {
+    State s;
+    s.t = t_;
+    s.x = download(x_[cur_]);
+    s.v = download(v_[cur_]);
+    if (sched_.integrator == Integrator::verlet && has_prev_) s.x_prev = download(x_[1 - cur_]);
+    return s;
+  }
+
+  void step() override {
+    const bool replay = o_.graphs && time_invariant() && !(sched_.integrator == Integrator::verlet && !has_prev_);
+    if (replay) {
+      if (!graph_[cur_]) capture(cur_);
+      check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");
+    } else {
+      enqueue_step();
+    }
+    if (sched_.integrator == Integrator::verlet) has_prev_ = true;
+    cur_ = 1 - cur_;
+    t_ += p_.dt;
+    stepped_ = true;
+  }
+
+  double max_displacement() override {
+    if (!stepped_) return 0.0;
+    const float d = thrust::transform_reduce(thrust::cuda::par.on(stream_), thrust::counting_iterator<int>(0),
+                                             thrust::counting_iterator<int>(n_),
+                                             DispOp{x_[cur_].get(), x_[1 - cur_].get(), v_[cur_].get()}, 0.f,
+                                             thrust::maximum<float>());
+    check(cudaStreamSynchronize(stream_), "reducing the largest displacement");
+    return std::isinf(d) ? std::numeric_limits<double>::quiet_NaN() : double(d);
+  }
+
+  Energy energy() override {
+    if (!springs_.get() && model_.spring_count() > 0) upload_springs();
+    const NodeEnergy ne = thrust::transform_reduce(
+        thrust::cuda::par.on(stream_), thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
+        NodeEnergyOp{x_[cur_].get(), v_[cur_].get(), widen(p_.gravity), widen(p_.wind)}, NodeEnergy{0.0, 0.0},
+        AddNodeEnergy{});
+    SpringEnergyOp op{springs_.get(), x_[cur_].get(), {model_.stiffness[0], model_.stiffness[1], model_.stiffness[2]}};
+    const double se = model_.spring_count() == 0
+                          ? 0.0
+                          : thrust::transform_reduce(thrust::cuda::par.on(stream_),
+                                                     thrust::counting_iterator<std::int64_t>(0),
+                                                     thrust::counting_iterator<std::int64_t>(model_.spring_count()),
+                                                     op, 0.0, thrust::plus<double>());
+    check(cudaStreamSynchronize(stream_), "reducing the energies");
+    Energy e;
+    e.kinetic = ne.kinetic;
+    e.field = ne.field;
+    e.spring = se;
+    return e;
+  }
+
+  double timed_steps(int steps) override {
+    check(cudaEventRecord(ev_[0], stream_), "recording the start event");
+    for (int k = 0; k < steps; ++k) step();
+    check(cudaEventRecord(ev_[1], stream_), "recording the end event");
+    check(cudaEventSynchronize(ev_[1]), "running the timed steps");
+    float ms = 0.f;
+    check(cudaEventElapsedTime(&ms, ev_[0], ev_[1]), "reading the step timer");
+    return ms;
+  }
+
+  std::int64_t device_bytes() const override {
+    std::int64_t b = spheres_.bytes() + offset_.bytes() + links_.bytes() + springs_.bytes();
+    for (const auto& a : x_) b += a.bytes();
+    for (const auto& a : v_) b += a.bytes();
+    for (const auto& a : sx_) b += a.bytes();
+    for (const auto& a : sv_) b += a.bytes();
+    for (const auto& a : acc_) b += a.bytes();
+    return b;
+  }
+
+ private:
+  template <class T>
+  void upload(Buffer<T>& b, const std::vector<T>& h, const char* what) {
+    b.allocate(h.size(), what);
+    copy_in(b.get(), h.data(), h.size() * sizeof(T), what);
+  }
+  // Uploads go through the pipeline's stream, ordered after the steps already queued.
+  void copy_in(void* dst, const void* src, std::size_t bytes, const char* what) {
+    if (bytes == 0) return;
+    check(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream_), what);
+    check(cudaStreamSynchronize(stream_), what);
+  }
+  void upload_springs() {
+    const Model& m = model_;
+    std::vector<Spring> sp(m.spring_count());
+    for (int e = 0; e < m.spring_count(); ++e) sp[e] = {m.spring_i[e], m.spring_j[e], int(m.kind[e]), m.rest_length[e]};
+    require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
+    upload(springs_, sp, "uploading the spring list");
+  }
+  void upload_positions(Buffer<float4>& b, const std::vector<Vec3f>& x) {
+    std::vector<float4> h(n_);
+    for (int i = 0; i < n_; ++i) h[i] = make_float4(x[i].x, x[i].y, x[i].z, model_.inv_mass[i]);
+    copy_in(b.get(), h.data(), h.size() * sizeof(float4), "uploading positions");
+  }
+  void upload_vectors(Buffer<float4>& b, const std::vector<Vec3f>& v) {
+    std::vector<float4> h(n_);
+    for (int i = 0; i < n_; ++i) h[i] = make_float4(v[i].x, v[i].y, v[i].z, 0.f);
+    copy_in(b.get(), h.data(), h.size() * sizeof(float4), "uploading velocities");
+  }
+  std::vector<Vec3f> download(const Buffer<float4>& b) {
+    std::vector<float4> h(n_);
+    check(cudaMemcpyAsync(h.data(), b.get(), h.size() * sizeof(float4), cudaMemcpyDeviceToHost, stream_),
+          "reading the state back");
+    check(cudaStreamSynchronize(stream_), "reading the state back");
+    std::vector<Vec3f> out(n_);
+    for (int i = 0; i < n_; ++i) out[i] = {h[i].x, h[i].y, h[i].z};
+    return out;
+  }
+
+  void check_tile(const Model& m) {
+    const Tile t = o_.tile;
+    if (t.x < 1 || t.y < 1 || t.x * t.y > 1024)
+      throw std::invalid_argument("CUDA tile " + std::to_string(t.x) + "x" + std::to_string(t.y) +
+                                  " is not a valid block shape (1..1024 threads)");
+    if (!grid_) return;
+    if ((m.ny + t.y - 1) / t.y > 65535 || m.nz > 65535)
+      throw std::invalid_argument("grid of " + std::to_string(m.ny) + " rows / " + std::to_string(m.nz) +
+                                  " layers exceeds the CUDA launch limits for tile height " + std::to_string(t.y));
+  }
+
+  // The drag handle's targets do not change from step to step (none, or past its path).
+  bool time_invariant() const { return !p_.drag.active() || t_ > p_.drag.end_time(); }
+
+  Targets targets(double time_fraction) const {
+    if (!p_.drag.active()) return {};
+    return {p_.drag.target(t_ + time_fraction * p_.dt), p_.drag.target(t_ + p_.dt)};
+  }
+
+  void capture(int parity) {
+    cudaGraph_t g = nullptr;
+    check(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeThreadLocal), "starting the step capture");
+    try {
+      enqueue_step();
+    } catch (...) {
+      cudaStreamEndCapture(stream_, &g);
+      if (g) cudaGraphDestroy(g);
+      throw;
+    }
+    check(cudaStreamEndCapture(stream_, &g), "capturing the step graph");
+    const cudaError_t e = cudaGraphInstantiate(&graph_[parity], g, 0);
+    cudaGraphDestroy(g);
+    check(e, "instantiating the step graph");
+  }
+
+  dim3 grid_blocks() const {
+    return dim3(unsigned((scene_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((scene_.ny + o_.tile.y - 1) / o_.tile.y),
+                unsigned(scene_.nz));
+  }
+  dim3 grid_threads() const { return dim3(unsigned(o_.tile.x), unsigned(o_.tile.y), 1); }
+
+  // Slot 0 is the current state, 1.. the stage states.
+  const float4* slot_x(int k) const { return k == 0 ? x_[cur_].get() : sx_[k - 1].get(); }
+  const float4* slot_v(int k) const { return k == 0 ? v_[cur_].get() : sv_[k - 1].get(); }
+
+  void enqueue_step() {
+    if (fused_) return fused_step();
+    for (const Pass& pass : sched_.passes) {
+      switch (pass.op) {
+        case Pass::Op::force: force_pass(pass.src, pass.acc, targets(pass.time_fraction).force); break;
+        case Pass::Op::stage: stage_pass(pass); break;
+        case Pass::Op::combine: combine_pass(pass); break;
+        case Pass::Op::fused: update_pass(); break;
+        case Pass::Op::solve: throw std::logic_error("solve pass on a CUDA pipeline");
+      }
+    }
+  }
+
+  template <int N, bool Damped, bool Tiled>
+  void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target) {
+    std::size_t shared = 0;
+    if (Tiled) {
+      const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
+                                (N > 12 ? 2 * dev::kHalo + 1 : 1);
+      shared = cells * sizeof(float4) * (Damped ? 2 : 1);
+      if (shared > 48 * 1024)
+        check(cudaFuncSetAttribute(dev::force_grid<N, Damped, Tiled>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                   int(shared)),
+              "raising the tiled kernel's shared-memory limit");
+    }
+    dev::force_grid<N, Damped, Tiled><<<grid_blocks(), grid_threads(), shared, stream_>>>(scene_, stencil_, x, v, acc, target);
+    check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
+  }
+
+  template <int N, bool Tiled>
+  void force_grid_dispatch(const float4* x, const float4* v, float4* acc, Vec3f target) {
+    if (damped_) launch_force_grid<N, true, Tiled>(x, v, acc, target);
+    else launch_force_grid<N, false, Tiled>(x, v, acc, target);
+  }
+
+  void force_pass(int src, int slot, Vec3f target) {
+    const float4 *x = slot_x(src), *v = slot_v(src);
+    float4* acc = acc_[slot].get();
+    if (o_.variant == Variant::scatter) {
+      check(cudaMemsetAsync(acc, 0, std::size_t(n_) * sizeof(float4), stream_), "clearing the force sums");
+      const std::int64_t s = std::int64_t(springs_.size());
+      if (s > 0) {
+        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream_>>>(scene_, springs_.get(), s, x, v, acc);
+        check_launch("launching the scatter kernel");
+      }
+      dev::scatter_finish<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x, v, acc, target);
+      check_launch("launching the scatter finishing kernel");
+      return;
+    }
+    if (!grid_) {
+      dev::force_csr<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, offset_.get(), links_.get(), x, v, acc, target);
+      check_launch("launching the CSR gather force kernel");
+      return;
+    }
+    const bool tiled = o_.variant == Variant::tiled;
+    if (scene_.nz > 1) {
+      if (tiled) force_grid_dispatch<dev::kMaxStencil, true>(x, v, acc, target);
+      else force_grid_dispatch<dev::kMaxStencil, false>(x, v, acc, target);
+    } else {
+      if (tiled) force_grid_dispatch<12, true>(x, v, acc, target);
+      else force_grid_dispatch<12, false>(x, v, acc, target);
+    }
+  }
+
+  template <Integrator I>
+  void update_as() {
+    const int nxt = 1 - cur_;
+    dev::update<I><<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x_[cur_].get(), v_[cur_].get(), acc_[0].get(),
+                                                           x_[nxt].get(), has_prev_, x_[nxt].get(), v_[nxt].get(),
+                                                           targets(0).end);
+    check_launch("launching the update kernel");
+  }
+  void update_pass() {
+    switch (sched_.integrator) {
+      case Integrator::explicit_euler: return update_as<Integrator::explicit_euler>();
+      case Integrator::semi_implicit_euler: return update_as<Integrator::semi_implicit_euler>();
+      case Integrator::verlet: return update_as<Integrator::verlet>();
+      default: throw std::logic_error("one-pass update for a multi-pass integrator");
+    }
+  }
+
+  void stage_pass(const Pass& pass) {
+    const float h = float(pass.coef * p_.dt);
+    dev::stage<<<blocks_for(n_), kBlock, 0, stream_>>>(n_, h, x_[cur_].get(), v_[cur_].get(), slot_v(pass.src),
+                                                       acc_[pass.acc].get(), sx_[pass.dst - 1].get(),
+                                                       sv_[pass.dst - 1].get());
+    check_launch("launching the stage kernel");
+  }
+
+  void combine_pass(const Pass& pass) {
+    dev::Terms terms{};
+    for (int k = 0; k < int(pass.weights.size()); ++k) {
+      if (pass.weights[k] == 0.0) continue;
+      terms.v[terms.count] = slot_v(k);
+      terms.a[terms.count] = acc_[k].get();
+      terms.weight[terms.count] = float(pass.weights[k]);
+      ++terms.count;
+    }
+    const int nxt = 1 - cur_;
+    dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x_[cur_].get(), v_[cur_].get(), terms,
+                                                         x_[nxt].get(), v_[nxt].get(), targets(0).end);
+    check_launch("launching the combine kernel");
+  }
+
+  template <int N, bool Damped, Integrator I>
+  void launch_fused_grid(const Targets& tg) {
+    const int nxt = 1 - cur_;
+    dev::fused_grid<N, Damped, I><<<grid_blocks(), grid_threads(), 0, stream_>>>(
+        scene_, stencil_, x_[cur_].get(), v_[cur_].get(), x_[nxt].get(), has_prev_, x_[nxt].get(), v_[nxt].get(), tg);
+    check_launch("launching the fused step kernel");
+  }
+  template <Integrator I>
+  void fused_as() {
+    const Targets tg = targets(0);
+    if (!grid_) {
+      const int nxt = 1 - cur_;
+      dev::fused_csr<I><<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, offset_.get(), links_.get(), x_[cur_].get(),
+                                                                v_[cur_].get(), x_[nxt].get(), has_prev_,
+                                                                x_[nxt].get(), v_[nxt].get(), tg);
+      check_launch("launching the fused CSR step kernel");
+    } else if (scene_.nz > 1) {
+      if (damped_) launch_fused_grid<dev::kMaxStencil, true, I>(tg);
+      else launch_fused_grid<dev::kMaxStencil, false, I>(tg);
+    } else {
+      if (damped_) launch_fused_grid<12, true, I>(tg);
+      else launch_fused_grid<12, false, I>(tg);
+    }
+  }
+  void fused_step() {
+    switch (sched_.integrator) {
+      case Integrator::explicit_euler: return fused_as<Integrator::explicit_euler>();
+      case Integrator::semi_implicit_euler: return fused_as<Integrator::semi_implicit_euler>();
+      case Integrator::verlet: return fused_as<Integrator::verlet>();
+      default: throw std::logic_error("fused step for a multi-pass integrator");
+    }
+  }
+
+  const Model& model_;
+  Params p_;
+  Schedule sched_;
+  Options o_;
+  int n_ = 0;
+  bool grid_ = false, fused_ = false, damped_ = false;
+  Scene scene_;
+  Stencil stencil_{};
+
+  Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
+                                // previous step's (Verlet: x_prev) until the next step
+  Buffer<float4> sx_[3], sv_[3], acc_[4];
+  Buffer<float4> spheres_;
+  Buffer<int> offset_;
+  Buffer<Link> links_;
+  Buffer<Spring> springs_;
+
+  cudaStream_t stream_ = nullptr;
+  cudaEvent_t ev_[2] = {};
+  cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
+  int cur_ = 0;
+  bool has_prev_ = false, stepped_ = false;
+  double t_ = 0.0;
+};
+
+}  // namespace
+
+std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
+  return std::make_unique<Impl>(s, o);
+}
+
+}  // namespace deformlab::cuda

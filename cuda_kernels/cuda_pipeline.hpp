@@ -1,0 +1,81 @@
+// The CUDA pipelines behind the registry names, with the knobs that tests and benchmarks
+// turn. Plain C++: includable without nvcc or CUDA headers.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "core/energy.hpp"
+#include "core/pipeline.hpp"
+
+namespace deformlab::cuda {
+
+enum class Variant {
+  naive,    // one thread per node gathering its springs from global memory
+  tiled,    // the same gather from a shared-memory tile of the grid with a 2-node halo
+  scatter,  // one thread per spring, +f / -f added with atomics (not bitwise deterministic)
+  fused,    // gather + update + constraints in one kernel for one-force-pass integrators
+};
+const char* to_string(Variant v);
+
+// Thread-block shape over a grid's (i, j) plane for the gather kernels (one node per
+// thread); cuda-tiled stages the block's nodes plus a 2-node halo in shared memory.
+struct Tile {
+  int x = 32, y = 8;
+};
+// "WxH" -> Tile; throws std::invalid_argument on anything else.
+Tile parse_tile(const std::string& s);
+// The tile named by the environment variable DEFORMLAB_CUDA_TILE ("WxH"), else the default.
+Tile tile_from_env();
+
+struct Options {
+  Variant variant = Variant::fused;
+  Tile tile;
+  // Replay each step as a captured CUDA graph when the step's kernel arguments do not
+  // change from step to step (no drag handle moving); cuts launch overhead at small sizes.
+  bool graphs = true;
+};
+
+class CudaPipeline : public Pipeline {
+ public:
+  // Kinetic, spring and field energy of the current state, reduced on the device.
+  virtual Energy energy() = 0;
+  // GPU time of `steps` steps, ms, from CUDA events recorded around them.
+  virtual double timed_steps(int steps) = 0;
+  // Device memory held by the pipeline, bytes.
+  virtual std::int64_t device_bytes() const = 0;
+  std::string timing_method() const override { return "CUDA events"; }
+};
+
+// Empty when a CUDA device can be used, else the reason (no driver, no device).
+std::string unavailable();
+// Empty when the CUDA pipelines run this integrator, else the reason.
+std::string unsupported(Integrator i);
+
+// Device memory a pipeline needs, bytes (state, stage slots, model arrays).
+std::int64_t bytes_needed(const Model& m, Integrator i, const Options& o);
+// Throws std::invalid_argument naming `what`, the bytes needed and the bytes free when the
+// device does not have `bytes` free.
+void require_device_memory(std::int64_t bytes, const std::string& what);
+
+// Throws std::invalid_argument for an unsupported integrator, a size that does not fit,
+// a bad tile; std::runtime_error for a CUDA failure.
+std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o);
+
+// For benchmarks.
+struct DeviceInfo {
+  std::string name;
+  int sm_count = 0;
+  double memory_gib = 0;
+  int cc_major = 0, cc_minor = 0;
+  int driver_version = 0, runtime_version = 0;
+};
+DeviceInfo device_info();
+// Median GPU time of a device-to-device cudaMemcpy of `bytes`, ms (CUDA events, `reps` copies
+// after one warm-up).
+double copy_ms(std::int64_t bytes, int reps);
+// Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
+// written once per kernel, neighbours served by caches.
+double floor_bytes_per_node(const Model& m, Integrator i, Variant v);
+
+}  // namespace deformlab::cuda

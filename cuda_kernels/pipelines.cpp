@@ -1,0 +1,116 @@
+#include "pipelines.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include "cuda_pipeline.hpp"
+
+namespace deformlab {
+namespace cuda {
+
+const char* to_string(Variant v) {
+  switch (v) {
+    case Variant::naive: return "naive";
+    case Variant::tiled: return "tiled";
+    case Variant::scatter: return "scatter";
+    case Variant::fused: return "fused";
+  }
+  return "?";
+}
+
+Tile parse_tile(const std::string& s) {
+  const auto x = s.find('x');
+  try {
+    std::size_t a = 0, b = 0;
+    if (x == std::string::npos) throw std::invalid_argument(s);
+    const int w = std::stoi(s.substr(0, x), &a), h = std::stoi(s.substr(x + 1), &b);
+    if (a != x || b != s.size() - x - 1 || w < 1 || h < 1 || w * h > 1024) throw std::invalid_argument(s);
+    return {w, h};
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument("CUDA tile '" + s + "' is not WxH with 1..1024 threads (e.g. 32x8)");
+  }
+}
+
+Tile tile_from_env() {
+  const char* s = std::getenv("DEFORMLAB_CUDA_TILE");
+  return s && *s ? parse_tile(s) : Tile{};
+}
+
+std::string unsupported(Integrator i) {
+  if (i == Integrator::backward_euler)
+    return "backward-euler needs a linear solve per step, which the CUDA pipelines do not have (use cpu, omp or "
+           "reference)";
+  return {};
+}
+
+std::int64_t bytes_needed(const Model& m, Integrator i, const Options& o) {
+  const Schedule s = make_schedule(i);
+  const std::int64_t n = m.node_count(), springs = m.spring_count(), f4 = 16;
+  std::int64_t b = n * 4 * f4;  // two (x, v) buffers
+  b += n * 2 * f4 * s.stage_states;
+  if (!(o.variant == Variant::fused && s.single_pass())) b += n * f4 * s.accel_slots;
+  if (m.topology == Topology::general && o.variant != Variant::scatter) b += (n + 1) * 4 + 2 * springs * 16;
+  if (o.variant == Variant::scatter) b += springs * 16;
+  return b;
+}
+
+double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
+  const Schedule s = make_schedule(i);
+  const double f4 = 16, springs_per_node = m.node_count() ? double(m.spring_count()) / m.node_count() : 0;
+  const double prev = i == Integrator::verlet ? f4 : 0;
+  const double links = m.topology == Topology::general ? 4 + 2 * springs_per_node * 16 : 0;
+  // Force pass: gather reads (x, v) and writes a. Scatter: clears the sums, reads every
+  // spring once and (x, v), adds into the sums, then reads them with (x, v) to write a.
+  const double force = v == Variant::scatter ? f4 + springs_per_node * 16 + 2 * f4 + 2 * f4 + 3 * f4 + f4
+                                             : 3 * f4 + links;
+  if (s.single_pass()) {
+    if (v == Variant::fused) return 4 * f4 + prev + links;  // (x, v) in, (x', v') out
+    return force + 3 * f4 + prev + 2 * f4;                  // update: x, v, a (+ x_prev) in, x', v' out
+  }
+  double b = 0;
+  for (const Pass& p : s.passes) {
+    switch (p.op) {
+      case Pass::Op::force: b += force; break;
+      case Pass::Op::stage: b += 6 * f4; break;  // x0, v0, v_src, a in; x, v out
+      case Pass::Op::combine: {
+        int terms = 0;
+        for (double w : p.weights) terms += w != 0.0;
+        b += 2 * f4 + terms * 2 * f4 + 2 * f4;
+        break;
+      }
+      default: break;
+    }
+  }
+  return b;
+}
+
+}  // namespace cuda
+
+void add_cuda_pipelines(PipelineRegistry& r) {
+  using cuda::Variant;
+  struct Entry {
+    const char* name;
+    Variant v;
+    bool deterministic;
+    const char* summary;
+  };
+  const Entry entries[] = {
+      {"cuda-naive", Variant::naive, true, "CUDA, one thread per node gathering its springs from global memory"},
+      {"cuda-tiled", Variant::tiled, true,
+       "CUDA, gather from a shared-memory tile with a 2-node halo (tile: DEFORMLAB_CUDA_TILE=WxH, default 32x8)"},
+      {"cuda-scatter", Variant::scatter, false,
+       "CUDA, one thread per spring, atomic scatter of +f/-f"},
+      {"cuda-fused", Variant::fused, true,
+       "CUDA, force + update + constraints in one kernel (one-pass integrators; others use the plain gather)"},
+  };
+  for (const Entry& e : entries) {
+    const Variant v = e.v;
+    r.add({e.name, e.summary, e.deterministic, [] { return cuda::unavailable(); },
+           [](Integrator i) { return cuda::unsupported(i); },
+           [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> {
+             return cuda::make_pipeline(s, {v, cuda::tile_from_env(), true});
+           }});
+  }
+}
+
+}  // namespace deformlab

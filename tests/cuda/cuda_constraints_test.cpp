@@ -1,0 +1,83 @@
+// Constraints on the CUDA pipelines: pins, the ground, spheres and both drag modes hold,
+// and the steps match the CPU's (tolerances as in cuda_pipeline_test.cpp).
+#include <gtest/gtest.h>
+
+#include "cuda_test_support.hpp"
+
+namespace deformlab::test {
+namespace {
+
+using cuda::Variant;
+
+constexpr int kSteps = 30;  // the drag path ends after 10: later steps replay a CUDA graph
+
+struct Scene {
+  Model m;
+  Params p;
+  std::vector<int> pinned;
+};
+
+Scene make_scene(bool spring_drag) {
+  Scene s{small_cloth(37, 53), small_params(), {}};
+  s.m.damping = {0.02f, 0.02f, 0.01f};
+  s.pinned = pin_nodes(s.m, PinSet::top_corners, {});
+  s.p.ground = 0.995f;  // just under the cloth: gravity and the perturbation push nodes below
+  s.p.spheres = {{{0.f, 0.9f, 0.f}, 0.12f}, {{0.5f, 0.97f, 0.3f}, 0.06f}};  // both cut the cloth from below
+  s.p.drag.node = 18 * 37 + 30;
+  s.p.drag.as_spring = spring_drag;
+  s.p.drag.path = {{0.f, s.m.rest_position[s.p.drag.node]},
+                   {0.01f, s.m.rest_position[s.p.drag.node] + Vec3f{0.02f, 0.05f, -0.01f}}};
+  return s;
+}
+
+void expect_constraints_hold(const Scene& sc, const State& s0, const State& g, const std::string& what) {
+  for (int i : sc.pinned) {
+    EXPECT_TRUE(g.x[i] == s0.x[i]) << what << ": pinned node " << i << " moved";
+    EXPECT_TRUE(g.v[i] == Vec3f{}) << what << ": pinned node " << i << " has a velocity";
+  }
+  for (int i = 0; i < sc.m.node_count(); ++i) {
+    if (sc.m.pinned(i)) continue;
+    EXPECT_GE(g.x[i].y, *sc.p.ground) << what << ": node " << i << " under the ground";
+    for (const Sphere& sp : sc.p.spheres)
+      EXPECT_GE(norm(g.x[i] - sp.center), sp.radius * (1 - 1e-6f)) << what << ": node " << i << " inside a sphere";
+  }
+  if (!sc.p.drag.as_spring) {
+    EXPECT_TRUE(g.x[sc.p.drag.node] == sc.p.drag.target(g.t)) << what << ": hard drag node off its target";
+  }
+}
+
+TEST(CudaConstraints, PinsGroundSpheresAndDragHold) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (bool spring_drag : {false, true}) {
+    const Scene sc = make_scene(spring_drag);
+    const State s0 = perturbed_state(sc.m, 21u);
+    for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
+                             Integrator::rk4, Integrator::verlet}) {
+      auto cpu = make_cpu_pipeline({sc.m, sc.p, integ}, Precision::f32, true);
+      const State c = advance(*cpu, s0, kSteps);
+      const Model mu = uniform_rest(sc.m);
+      auto cpu_u = make_cpu_pipeline({mu, sc.p, integ}, Precision::f32, true);
+      const State u = advance(*cpu_u, s0, kSteps);
+      auto ref = make_cpu_pipeline({sc.m, sc.p, integ}, Precision::f64, true);
+      const State r = advance(*ref, s0, kSteps);
+      const Tolerance floor = rounding_floor(c, sc.p.dt);
+      for (Variant v : {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused}) {
+        const std::string what = std::string(name(v)) + " " + std::string(info(integ).name) +
+                                 (spring_drag ? " spring drag" : " hard drag");
+        auto gpu = cuda::make_pipeline({sc.m, sc.p, integ}, {v, {}, true});
+        const State g = advance(*gpu, s0, kSteps);
+        expect_constraints_hold(sc, s0, g, what);
+        if (v != Variant::scatter) {
+          EXPECT_TRUE(bitwise_equal(g, u)) << what << ": x diff " << max_position_diff(g, u);
+          EXPECT_EQ(gpu->max_displacement(), cpu_u->max_displacement()) << what;
+        } else {
+          EXPECT_LE(max_position_diff(g, c), 4 * max_position_diff(c, r) + floor.x) << what;
+          EXPECT_LE(max_velocity_diff(g, c), 4 * max_velocity_diff(c, r) + floor.v) << what;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace deformlab::test

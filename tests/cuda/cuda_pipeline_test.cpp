@@ -1,0 +1,270 @@
+// The CUDA pipelines against the CPU float pipeline, from perturbed, moving states.
+//
+// Tolerances:
+// - Gather variants (naive, tiled, fused) do the CPU's float operations in the CPU's order
+//   (same adjacency order, no FMA contraction), so on a grid whose springs of one offset
+//   share one rest length they must be bitwise equal to the CPU, and on a general model
+//   (CSR) bitwise equal with any rest lengths.
+// - On the builders' grids (rest lengths a few ulps apart within one offset) the only
+//   difference is that representation: the GPU may differ from the CPU by at most twice
+//   what the same change does to the CPU run, plus a rounding floor (4 ulps of the largest
+//   coordinate; over dt for velocities).
+// - Scatter sums the forces in atomic order. Its rounding differs from the CPU's by about
+//   as much as float differs from double: tolerance 4 x |cpu float - cpu double| + floor.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <stdexcept>
+
+#include "core/energy.hpp"
+#include "cuda_kernels/pipelines.hpp"
+#include "cuda_test_support.hpp"
+
+namespace deformlab::test {
+namespace {
+
+using cuda::Variant;
+
+constexpr int kSteps = 12;
+
+struct Shape {
+  const char* name;
+  int nx, ny, nz;  // nz > 0: lattice
+  bool damped;     // spring damping on (exercises the neighbour-velocity loads)
+};
+const Shape kShapes[] = {
+    {"1x1", 1, 1, 0, false},     {"2x3", 2, 3, 0, true},       {"37x53", 37, 53, 0, true},
+    {"130x70", 130, 70, 0, false}, {"256x256", 256, 256, 0, true}, {"lattice7x5x6", 7, 5, 6, true},
+};
+
+Model make_model(const Shape& s) {
+  // 1x1 free, so that its one node moves; the others have their top corners pinned.
+  Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny, s.nx * s.ny > 1);
+  if (s.damped) m.damping = {0.02f, 0.02f, 0.01f};
+  return m;
+}
+
+Params scene_params() {
+  Params p = small_params();
+  p.wind = {0.002f, 0.f, -0.001f};
+  return p;
+}
+
+State run_cpu(const Model& m, const Params& p, Integrator i, const State& s0, Precision prec = Precision::f32,
+              double* disp = nullptr) {
+  auto cpu = make_cpu_pipeline({m, p, i}, prec, true);
+  State s = advance(*cpu, s0, kSteps);
+  if (disp) *disp = cpu->max_displacement();
+  return s;
+}
+
+Tolerance diff(const State& a, const State& b) { return {max_position_diff(a, b), max_velocity_diff(a, b)}; }
+
+const Integrator kIntegrators[] = {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
+                                   Integrator::rk4, Integrator::verlet};
+const Variant kVariants[] = {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused};
+
+using Param = std::tuple<Variant, Integrator, int>;
+
+class MatchesCpu : public ::testing::TestWithParam<Param> {};
+
+TEST_P(MatchesCpu, FromPerturbedState) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const auto [variant, integ, shape_index] = GetParam();
+  const Shape& shape = kShapes[shape_index];
+  const Model m = make_model(shape);
+  const Params p = scene_params();
+  const State s0 = perturbed_state(m, 1234u + unsigned(shape_index));
+
+  auto gpu = cuda::make_pipeline({m, p, integ}, {variant, {}, true});
+  const State g = advance(*gpu, s0, kSteps);
+  const double g_disp = gpu->max_displacement();
+  ASSERT_TRUE(std::isfinite(g_disp));
+
+  double c_disp = 0;
+  const State c = run_cpu(m, p, integ, s0, Precision::f32, &c_disp);
+  const Tolerance floor = rounding_floor(c, p.dt);
+
+  if (variant != Variant::scatter) {
+    // Exact: the CPU on the model as the grid kernels see it.
+    const Model mu = uniform_rest(m);
+    double u_disp = 0;
+    const State u = run_cpu(mu, p, integ, s0, Precision::f32, &u_disp);
+    EXPECT_TRUE(bitwise_equal(g, u)) << "x diff " << max_position_diff(g, u) << " m, v diff "
+                                     << max_velocity_diff(g, u) << " m/s";
+    EXPECT_EQ(g_disp, u_disp);
+    // Within the representation's effect of the builder's model.
+    const Tolerance rep = diff(u, c);
+    EXPECT_LE(max_position_diff(g, c), 2 * rep.x + floor.x);
+    EXPECT_LE(max_velocity_diff(g, c), 2 * rep.v + floor.v);
+    EXPECT_LE(std::abs(g_disp - c_disp), 2 * rep.x + floor.x);
+    // General (CSR) path: bitwise equal to the CPU on the same model.
+    if (variant != Variant::tiled && m.spring_count() > 0) {
+      const Model mg = as_general(m);
+      auto csr = cuda::make_pipeline({mg, p, integ}, {variant, {}, true});
+      const State gc = advance(*csr, s0, kSteps);
+      EXPECT_TRUE(bitwise_equal(gc, c)) << "CSR path: x diff " << max_position_diff(gc, c) << " m";
+      EXPECT_EQ(csr->max_displacement(), c_disp);
+    }
+  } else {
+    const State r = run_cpu(m, p, integ, s0, Precision::f64);
+    const Tolerance fd = diff(c, r);
+    const Tolerance tol{4 * fd.x + floor.x, 4 * fd.v + floor.v};
+    EXPECT_LE(max_position_diff(g, c), tol.x);
+    EXPECT_LE(max_velocity_diff(g, c), tol.v);
+    EXPECT_LE(std::abs(g_disp - c_disp), 2 * tol.x);
+    EXPECT_EQ(g.x_prev.size(), c.x_prev.size());
+  }
+}
+
+std::string param_name(const ::testing::TestParamInfo<Param>& info) {
+  std::string s = std::string(cuda::to_string(std::get<0>(info.param))) + "_" +
+                  std::string(deformlab::info(std::get<1>(info.param)).name) + "_" + kShapes[std::get<2>(info.param)].name;
+  for (char& ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(Cuda, MatchesCpu,
+                         ::testing::Combine(::testing::ValuesIn(kVariants), ::testing::ValuesIn(kIntegrators),
+                                            ::testing::Range(0, int(std::size(kShapes)))),
+                         param_name);
+
+TEST(CudaPipeline, GatherVariantsAreBitwiseEqualRunToRun) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (const Shape& shape : {kShapes[4], kShapes[5]}) {
+    const Model m = make_model(shape);
+    const Params p = scene_params();
+    const State s0 = perturbed_state(m, 7u);
+    for (Variant v : {Variant::naive, Variant::tiled, Variant::fused})
+      for (Integrator i : kIntegrators) {
+        auto a = cuda::make_pipeline({m, p, i}, {v, {}, true});
+        auto b = cuda::make_pipeline({m, p, i}, {v, {}, false});  // also: graphs change nothing
+        EXPECT_TRUE(bitwise_equal(advance(*a, s0, kSteps), advance(*b, s0, kSteps)))
+            << name(v) << " " << info(i).name << " " << shape.name;
+        const State again = advance(*a, s0, kSteps);  // set_state restarts the same pipeline
+        EXPECT_TRUE(bitwise_equal(again, advance(*b, s0, kSteps))) << name(v) << " " << info(i).name;
+      }
+  }
+}
+
+TEST(CudaPipeline, EveryTileShapeGivesTheSameBits) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (const Shape& shape : {kShapes[3], kShapes[5]}) {
+    const Model m = make_model(shape);
+    const Params p = scene_params();
+    const State s0 = perturbed_state(m, 11u);
+    const State want = run_cpu(uniform_rest(m), p, Integrator::semi_implicit_euler, s0);
+    for (cuda::Tile t : {cuda::Tile{8, 8}, cuda::Tile{16, 16}, cuda::Tile{5, 3}, cuda::Tile{64, 4}, cuda::Tile{1, 1}})
+      for (Variant v : {Variant::tiled, Variant::naive, Variant::fused}) {
+        auto g = cuda::make_pipeline({m, p, Integrator::semi_implicit_euler}, {v, t, true});
+        EXPECT_TRUE(bitwise_equal(advance(*g, s0, kSteps), want))
+            << name(v) << " tile " << t.x << "x" << t.y << " " << shape.name;
+      }
+  }
+}
+
+TEST(CudaPipeline, VerletContinuesFromAGivenPreviousPosition) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = uniform_rest(make_model(kShapes[2]));
+  const Params p = scene_params();
+  auto cpu = make_cpu_pipeline({m, p, Integrator::verlet}, Precision::f32, false);
+  const State mid = advance(*cpu, perturbed_state(m, 5u), 4);
+  ASSERT_FALSE(mid.x_prev.empty());
+  const State want = advance(*cpu, mid, kSteps);
+  for (Variant v : {Variant::naive, Variant::tiled, Variant::fused}) {
+    auto g = cuda::make_pipeline({m, p, Integrator::verlet}, {v, {}, true});
+    EXPECT_TRUE(bitwise_equal(advance(*g, mid, kSteps), want)) << name(v);
+  }
+}
+
+TEST(CudaPipeline, MaxDisplacementIsNanWhenTheStateIsNotFinite) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = make_model(kShapes[2]);
+  State s = perturbed_state(m, 3u);
+  s.v[100].y = std::numeric_limits<float>::quiet_NaN();
+  for (Variant v : kVariants) {
+    auto g = cuda::make_pipeline({m, scene_params(), Integrator::semi_implicit_euler}, {v, {}, true});
+    g->set_state(s);
+    EXPECT_EQ(g->max_displacement(), 0.0) << "no step yet";
+    g->step();
+    EXPECT_TRUE(std::isnan(g->max_displacement())) << name(v);
+  }
+}
+
+TEST(CudaPipeline, EnergyMatchesTheHostComputation) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (const Shape& shape : {kShapes[4], kShapes[5]}) {
+    const Model m = make_model(shape);
+    Params p = scene_params();
+    auto g = cuda::make_pipeline({m, p, Integrator::verlet}, {Variant::fused, {}, true});
+    const State s = advance(*g, perturbed_state(m, 9u), kSteps);
+    const Energy want = energy(m, p, s), got = g->energy();
+    // Both sum the same double terms from the same floats, in a different order.
+    auto close = [](double a, double b) { return std::abs(a - b) <= 1e-10 * std::max(1.0, std::abs(b)); };
+    EXPECT_TRUE(close(got.kinetic, want.kinetic)) << got.kinetic << " vs " << want.kinetic;
+    EXPECT_TRUE(close(got.spring, want.spring)) << got.spring << " vs " << want.spring;
+    EXPECT_TRUE(close(got.field, want.field)) << got.field << " vs " << want.field;
+    EXPECT_GT(got.spring, 0.0);
+  }
+}
+
+TEST(CudaPipeline, RefusesASizeThatDoesNotFit) {
+  DEFORMLAB_REQUIRE_CUDA();
+  try {
+    cuda::require_device_memory(std::int64_t(1) << 50, "a test buffer");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("a test buffer needs 1125899906842624 bytes"), std::string::npos) << what;
+    EXPECT_NE(what.find("bytes are free"), std::string::npos) << what;
+  }
+  const Model m = make_model(kShapes[4]);
+  EXPECT_NO_THROW(cuda::require_device_memory(cuda::bytes_needed(m, Integrator::rk4, {}), "a 256x256 cloth"));
+  // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers.
+  EXPECT_EQ(cuda::bytes_needed(m, Integrator::rk4, {Variant::naive, {}, true}), m.node_count() * 16 * (4 + 6 + 4));
+  EXPECT_EQ(cuda::bytes_needed(m, Integrator::verlet, {Variant::fused, {}, true}), m.node_count() * 16 * 4);
+}
+
+// ---- no device needed ----
+
+TEST(CudaPipeline, BackwardEulerIsRefusedWithAReason) {
+  EXPECT_NE(cuda::unsupported(Integrator::backward_euler).find("backward-euler"), std::string::npos);
+  for (Integrator i : kIntegrators) EXPECT_EQ(cuda::unsupported(i), "");
+  const Model m = make_model(kShapes[1]);
+  EXPECT_THROW(cuda::make_pipeline({m, scene_params(), Integrator::backward_euler}, {}), std::invalid_argument);
+}
+
+TEST(CudaPipeline, RegistryNamesTheFourVariants) {
+  PipelineRegistry r;
+  add_cuda_pipelines(r);
+  ASSERT_EQ(r.all().size(), 4u);
+  for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-scatter", "cuda-fused"}) {
+    const PipelineEntry* e = r.find(n);
+    ASSERT_NE(e, nullptr) << n;
+    EXPECT_EQ(e->deterministic, std::string(n) != "cuda-scatter") << n;
+    EXPECT_FALSE(e->unsupported(Integrator::backward_euler).empty());
+    EXPECT_EQ(e->unavailable(), cuda::unavailable());
+  }
+}
+
+TEST(CudaPipeline, WithoutADeviceMakingAPipelineFailsWithTheReason) {
+  if (cuda::unavailable().empty()) GTEST_SKIP() << "a CUDA device is present";
+  const Model m = make_model(kShapes[1]);
+  try {
+    cuda::make_pipeline({m, scene_params(), Integrator::verlet}, {});
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), cuda::unavailable());
+  }
+}
+
+TEST(CudaPipeline, ParsesTileShapes) {
+  EXPECT_EQ(cuda::parse_tile("16x8").x, 16);
+  EXPECT_EQ(cuda::parse_tile("16x8").y, 8);
+  for (const char* bad : {"", "16", "0x8", "x8", "16x", "64x64", "8x8x", "a8x8"})
+    EXPECT_THROW(cuda::parse_tile(bad), std::invalid_argument) << bad;
+}
+
+}  // namespace
+}  // namespace deformlab::test

@@ -1,0 +1,71 @@
+// Helpers for the CUDA pipeline tests: the skip rule, model variants and comparisons.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "core/cpu_backend.hpp"
+#include "cuda_kernels/cuda_pipeline.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+
+// Every test that needs a device skips cleanly without one (no driver, no GPU).
+#define DEFORMLAB_REQUIRE_CUDA()                                          \
+  do {                                                                    \
+    if (const std::string why = cuda::unavailable(); !why.empty()) GTEST_SKIP() << why; \
+  } while (0)
+
+// The grid kernels use one rest length per stencil offset: the model's value for the first
+// spring with that offset. The builders' rest lengths vary by a few ulps between springs of
+// one offset (they come from float rest positions), so the CPU pipeline run on this model is
+// what the grid kernels must reproduce operation for operation.
+inline Model uniform_rest(Model m) {
+  if (m.topology == Topology::general) return m;
+  const std::int64_t nxy = std::int64_t(m.nx) * m.ny;
+  std::vector<float> first(9 * 9 * 9, NAN);
+  for (int e = 0; e < m.spring_count(); ++e) {
+    const int a = m.spring_i[e], b = m.spring_j[e];
+    const int di = b % m.nx - a % m.nx, dj = int((b / m.nx) % m.ny - (a / m.nx) % m.ny), dk = int(b / nxy - a / nxy);
+    float& r = first[((dk + 4) * 9 + dj + 4) * 9 + di + 4];
+    if (std::isnan(r)) r = m.rest_length[e];
+    m.rest_length[e] = r;
+  }
+  return m;
+}
+
+// The same springs, seen as a general model: the kernels then gather over the CSR adjacency.
+inline Model as_general(Model m) {
+  m.topology = Topology::general;
+  return m;
+}
+
+inline bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)) == 0);
+}
+inline bool bitwise_equal(const State& a, const State& b) {
+  return bitwise_equal(a.x, b.x) && bitwise_equal(a.v, b.v) && bitwise_equal(a.x_prev, b.x_prev) && a.t == b.t;
+}
+
+inline double max_abs_position(const State& s) {
+  double m = 0;
+  for (const auto& x : s.x) m = std::max({m, double(std::abs(x.x)), double(std::abs(x.y)), double(std::abs(x.z))});
+  return m;
+}
+
+// A rounding floor for comparing two float runs: 4 ulps of the largest coordinate for
+// positions; for velocities, the same turned into a velocity by 1/dt (Verlet's v is a
+// position difference over dt).
+struct Tolerance {
+  double x = 0, v = 0;
+};
+inline Tolerance rounding_floor(const State& s, float dt) {
+  const double ulp = std::ldexp(1.0, std::ilogb(std::max(max_abs_position(s), 1e-3)) - 23);
+  return {4 * ulp, 4 * ulp / dt};
+}
+
+inline const char* name(cuda::Variant v) { return cuda::to_string(v); }
+
+}  // namespace deformlab::test
