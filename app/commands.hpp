@@ -16,6 +16,8 @@ struct RunArgs {
   std::optional<double> dt, threshold;
   bool until_converged = false;
   std::optional<std::string> out;
+  std::optional<int> frames;     // render a frame every N steps into DIR/frames (GL builds)
+  std::optional<int> gl_device;  // EGL device index for the GL context (GL builds)
 };
 
 struct ExperimentArgs {

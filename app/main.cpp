@@ -42,6 +42,8 @@ int main(int argc, char** argv) {
   run->add_option("--option", a.options, "Pipeline option NAME=VALUE (repeatable; 'deformlab list' names them)");
   run->add_option("--compare", a.compare, "Also run the double-precision reference ('cpu') and report the error");
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
+  run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
+  run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)");
 
   deformlab::app::ExperimentArgs ex;
   ex.argv = a.argv;

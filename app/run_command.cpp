@@ -11,6 +11,10 @@
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
+#if DEFORMLAB_GL_RENDER
+#include "glsl_tf/context.hpp"
+#include "glsl_tf/render.hpp"
+#endif
 
 namespace deformlab::app {
 namespace {
@@ -67,6 +71,12 @@ int run_command(const RunArgs& a) {
   bool until_converged = false;
   PipelineOptions options;
   try {
+#if DEFORMLAB_GL_RENDER
+    if (a.gl_device) gl::configure({.device = *a.gl_device});
+    if (a.frames && *a.frames < 1) throw BadInput("--frames must be at least 1");
+#else
+    if (a.frames || a.gl_device) throw BadInput("--frames and --gl-device need a build with OpenGL");
+#endif
     x = a.experiment ? load_experiment(*a.experiment) : default_experiment();
     if (a.scene) {
       Scene s = load_scene(*a.scene);
@@ -151,7 +161,17 @@ int run_command(const RunArgs& a) {
     pipe->set_state(rest_state(model));
     RunOptions opt;
     opt.until_converged = until_converged;
+#if DEFORMLAB_GL_RENDER
+    std::optional<gl::FrameWriter> frames;
+    if (a.frames) {
+      frames.emplace(model, dir.staged("frames"), *a.frames);
+      opt.after_step = [&](int step) { frames->after_step(*pipe, step); };
+    }
+#endif
     const RunResult r = run(*pipe, model, params, opt);
+#if DEFORMLAB_GL_RENDER
+    if (frames) frames->finish(*pipe, r.steps);
+#endif
     const State final_state = pipe->state();
 
     nlohmann::json compare;
@@ -192,6 +212,10 @@ int run_command(const RunArgs& a) {
         {"build", build_info()},
         {"machine", machine_info()}};
     if (a.compare) manifest["compare"] = compare;
+#if DEFORMLAB_GL_RENDER
+    if (frames) manifest["frames"] = frames->manifest();
+    if (auto g = gl::run_manifest(*pipe); !g.is_null()) manifest["gl"] = g;
+#endif
     write_json(dir.staged("manifest.json"), manifest);
     dir.commit();
 

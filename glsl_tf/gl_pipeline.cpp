@@ -1,5 +1,6 @@
 #include "gl_pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -33,6 +34,11 @@ constexpr int kDragNone = 0, kDragHard = 1, kDragSpring = 2;
 std::vector<StencilOffset> grid_stencil(const Model& m) {
   if (m.topology == Topology::general || m.nx < 1 || m.ny < 1 || m.nz < 1) return {};
   const int nx = m.nx, ny = m.ny, nz = m.nz;
+  // The builder derives rest lengths from float rest positions, so one offset's springs
+  // differ by the rounding of those positions; within that they share the first one's.
+  float largest = 0.f;
+  for (const auto& p : m.rest_position) largest = std::max({largest, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  const float rounding = 4.f * largest * std::numeric_limits<float>::epsilon();
   auto coord = [&](int v) { return std::array<int, 3>{v % nx, (v / nx) % ny, v / (nx * ny)}; };
   std::vector<StencilOffset> st;
   std::vector<std::int64_t> count;
@@ -48,7 +54,7 @@ std::vector<StencilOffset> grid_stencil(const Model& m) {
       st.push_back({di, dj, dk, kind, m.rest_length[e]});
       count.push_back(0);
     }
-    if (st[s].kind != kind || st[s].rest != m.rest_length[e]) return {};
+    if (st[s].kind != kind || std::abs(st[s].rest - m.rest_length[e]) > rounding) return {};
     std::uint32_t& bit = seen[std::size_t(m.spring_i[e])];
     if (bit & (1u << s)) return {};  // the same pair twice
     bit |= 1u << s;

@@ -12,8 +12,9 @@
 
 namespace deformlab::gl {
 
-// The half stencil of a grid or lattice model when every spring of one grid offset has the
-// same kind and rest length (then kernels find neighbours by arithmetic), else empty.
+// The half stencil of a grid or lattice model when its springs are exactly every in-bounds
+// pair of a few grid offsets, each offset of one kind and one rest length up to the rounding
+// of the float rest positions (then shaders find neighbours by arithmetic), else empty.
 struct StencilOffset {
   int di, dj, dk, kind;
   float rest;

@@ -40,6 +40,13 @@ Mat4 perspective(float fovy, float aspect, float znear, float zfar) {
           0, 0, 2 * zfar * znear / (znear - zfar), 0};
 }
 
+// The framebuffer to restore after drawing (the context keeps a 1x1 one bound: see context.cpp).
+GLint bound_framebuffer(GLenum which = GL_DRAW_FRAMEBUFFER_BINDING) {
+  GLint id = 0;
+  glGetIntegerv(which, &id);
+  return id;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
@@ -81,11 +88,12 @@ struct Renderer::Impl {
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, o.width, o.height);
     glGenFramebuffers(1, &id);
     fbo = Framebuffer(id);
+    const GLint previous = bound_framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, id);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color.id());
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth.id());
     const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     if (!complete) throw std::runtime_error("the render framebuffer is incomplete");
     prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
     glGenVertexArrays(1, &id);
@@ -104,10 +112,12 @@ struct Renderer::Impl {
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indices.id());
       glBindVertexArray(0);
     }
-    // Camera: in front of and above the rest shape, looking at its centre.
+    // Camera: in front of and above the rest shape and the space below it where a pinned
+    // model hangs, looking at the centre of both.
     Vec3f lo = m.rest_position[0], hi = lo;
     for (const auto& p : m.rest_position)
       for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+    lo.y -= 0.6f * std::max({hi.x - lo.x, hi.z - lo.z});
     const Vec3f centre = (lo + hi) * 0.5f;
     const float radius = std::max(0.5f * norm(hi - lo), 1e-3f);
     eye = centre + Vec3f{0.f, 0.9f, 2.2f} * radius;
@@ -123,6 +133,7 @@ struct Renderer::Impl {
       draw_source = positions;
     }
     timer.begin();
+    const GLint previous = bound_framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
     glViewport(0, 0, o.width, o.height);
     glClearColor(0.12f, 0.13f, 0.15f, 1.f);
@@ -147,7 +158,7 @@ struct Renderer::Impl {
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
     timer.end();
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     check("rendering a frame");
   }
 
@@ -195,10 +206,11 @@ std::vector<std::uint8_t> Renderer::pixels() {
   context();
   const Impl& r = *impl_;
   std::vector<std::uint8_t> px(std::size_t(r.o.width) * r.o.height * 4);
+  const GLint previous = bound_framebuffer(GL_READ_FRAMEBUFFER_BINDING);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo.id());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, r.o.width, r.o.height, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(previous));
   check("reading a frame back");
   // GL rows start at the bottom.
   const std::size_t row = std::size_t(r.o.width) * 4;
@@ -258,10 +270,16 @@ nlohmann::json FrameWriter::manifest() const {
   return j;
 }
 
-nlohmann::json context_manifest() {
+nlohmann::json run_manifest(Pipeline& p) {
   if (!context_created()) return nullptr;
   const ContextInfo& c = context();
-  return {{"vendor", c.vendor}, {"renderer", c.renderer}, {"version", c.version}, {"platform", c.platform}};
+  nlohmann::json j = {{"vendor", c.vendor}, {"renderer", c.renderer}, {"version", c.version}, {"platform", c.platform}};
+  if (auto* g = dynamic_cast<GlPipeline*>(&p)) {
+    j["update_ms_median"] = median(g->take_step_ms());
+    j["update_timing"] = g->timing_method();
+    j["neighbours"] = g->neighbour_mode();
+  }
+  return j;
 }
 
 }  // namespace deformlab::gl

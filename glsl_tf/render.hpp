@@ -63,7 +63,8 @@ class FrameWriter {
   std::string movie_;
 };
 
-// GL vendor, renderer, version and platform, or null when no GL context was made.
-nlohmann::json context_manifest();
+// For a run's manifest: GL vendor, renderer, version and platform and, for a GL pipeline,
+// its median GPU update time per step and how it was timed; null when no GL context was made.
+nlohmann::json run_manifest(Pipeline& p);
 
 }  // namespace deformlab::gl

@@ -1,0 +1,78 @@
+// Failures are reported where they happen: a broken shader with its name and the driver's
+// log (and a non-zero exit of the command), no EGL display with one clear error (exit 2).
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+#include "gl_test_support.hpp"
+#include "glsl_tf/objects.hpp"
+
+namespace deformlab::test {
+namespace {
+
+struct Command {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Command run_deformlab(const std::string& env, const std::string& args) {
+  const std::string cmd = env + " '" DEFORMLAB_BIN "' " + args + " 2>&1";
+  FILE* f = ::popen(cmd.c_str(), "r");
+  if (!f) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), f)) > 0;) out.append(buf.data(), n);
+  const int status = ::pclose(f);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::filesystem::path temp_dir(const std::string& tag) {
+  auto d = std::filesystem::temp_directory_path() / ("deformlab-" + tag + "-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+TEST(GlErrors, BrokenShaderGivesItsNameAndLog) {
+  DEFORMLAB_REQUIRE_GL();
+  try {
+    gl::make_program_from_source(GL_VERTEX_SHADER, "broken.vert",
+                                 "#version 430 core\nvoid main() { gl_Position = vec4(undefined_thing); }\n");
+    FAIL() << "a broken shader compiled";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("broken.vert"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("undefined_thing"), std::string::npos) << "no driver log in: " << msg;
+  }
+}
+
+TEST(GlErrors, BrokenShaderFileFailsTheRun) {
+  DEFORMLAB_REQUIRE_GL();
+  const auto dir = temp_dir("shaders");
+  std::ofstream(dir / "step.vert") << "#version 430 core\nvoid main() { this is not glsl; }\n";
+  const Command c = run_deformlab("DEFORMLAB_SHADER_DIR='" + dir.string() + "'",
+                                  "run -p glsl-tf --grid 8x8 --steps 2 -o '" + (dir / "out").string() + "'");
+  std::filesystem::remove_all(dir);
+  EXPECT_NE(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("step.vert"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("failed to compile"), std::string::npos) << c.output;
+}
+
+// No EGL vendor library at all: what a machine without a GL driver looks like.
+TEST(GlErrors, MissingEglDisplayIsOneClearError) {
+  const std::string env = "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl_vendor.json";
+  const auto dir = temp_dir("nodisplay");
+  const Command run = run_deformlab(env, "run -p glsl-compute --grid 8x8 --steps 1 -o '" + (dir / "out").string() + "'");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("OpenGL unavailable: no EGL display"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
+  std::filesystem::remove_all(dir);
+  const Command list = run_deformlab(env, "list");
+  EXPECT_EQ(list.exit_code, 0) << list.output;
+  EXPECT_NE(list.output.find("glsl-tf        unavailable"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("why: OpenGL unavailable"), std::string::npos) << list.output;
+}
+
+}  // namespace
+}  // namespace deformlab::test

@@ -1,0 +1,111 @@
+// Rendering: the cloth shows where the camera looks, from GL buffers and from CPU states.
+#include <array>
+#include <filesystem>
+#include <fstream>
+
+#include "core/cpu_backend.hpp"
+#include "gl_test_support.hpp"
+#include "glsl_tf/render.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+struct Coverage {
+  long pixels = 0;
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+};
+
+// Pixels that differ from the background (the top-left corner's colour).
+Coverage coverage(const std::vector<std::uint8_t>& px, int w, int h) {
+  Coverage c;
+  const std::array<std::uint8_t, 3> bg = {px[0], px[1], px[2]};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::uint8_t* p = &px[(std::size_t(y) * w + x) * 4];
+      if (p[0] == bg[0] && p[1] == bg[1] && p[2] == bg[2]) continue;
+      ++c.pixels;
+      c.x0 = std::min(c.x0, x); c.x1 = std::max(c.x1, x);
+      c.y0 = std::min(c.y0, y); c.y1 = std::max(c.y1, y);
+    }
+  return c;
+}
+
+void expect_centred(const Coverage& c, int w, int h, double min_fraction, const std::string& what) {
+  const double frac = double(c.pixels) / (double(w) * h);
+  EXPECT_GT(frac, min_fraction) << what << ": too few pixels drawn";
+  EXPECT_LT(frac, 0.9) << what << ": the frame is filled";
+  // The camera looks at the model's centre from the front: the drawing straddles the
+  // middle column, spans a good part of the width and lies inside the frame, not cut.
+  EXPECT_LE(c.x0, w / 2) << what;
+  EXPECT_GE(c.x1, w / 2) << what;
+  EXPECT_GT(c.x1 - c.x0, w / 3) << what << ": the cloth should span the frame";
+  EXPECT_GT(c.x0, 0) << what;
+  EXPECT_LT(c.x1, w - 1) << what;
+  EXPECT_GT(c.y0, 0) << what;
+  EXPECT_LT(c.y1, h - 1) << what;
+}
+
+TEST(GlRender, ClothSurfaceFromEveryKindOfPipeline) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(32, 32);
+  const Params p = small_params();
+  gl::Renderer r(m, {256, 256});
+  std::vector<long> counts;
+  for (const char* name : {"glsl-tf", "glsl-compute", "cpu"}) {
+    auto pipe = std::string(name) == "cpu" ? make_cpu_pipeline({m, p, Integrator::semi_implicit_euler}, Precision::f32, false)
+                                           : make_gl(name, {m, p, Integrator::semi_implicit_euler});
+    pipe->set_state(rest_state(m));
+    for (int k = 0; k < 30; ++k) pipe->step();
+    r.draw(*pipe);
+    const Coverage c = coverage(r.pixels(), 256, 256);
+    expect_centred(c, 256, 256, 0.1, name);
+    counts.push_back(c.pixels);
+  }
+  // The same state drawn from GL buffers or uploaded from the CPU covers the same pixels
+  // up to the float rounding of the two trajectories.
+  EXPECT_NEAR(double(counts[0]), double(counts[2]), 0.01 * double(counts[2]));
+  EXPECT_NEAR(double(counts[1]), double(counts[2]), 0.01 * double(counts[2]));
+  EXPECT_EQ(r.take_draw_ms().size(), 3u);
+}
+
+TEST(GlRender, LatticeAsPointsAndPngFile) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_lattice(6, 5, 4);
+  gl::Renderer r(m, {200, 160, gl::RenderOptions::Mode::points});
+  r.draw(rest_state(m));
+  const Coverage c = coverage(r.pixels(), 200, 160);
+  EXPECT_GT(c.pixels, 100);
+  EXPECT_LE(c.x0, 100);
+  EXPECT_GE(c.x1, 100);
+  const auto file = std::filesystem::temp_directory_path() / ("deformlab-gl-test-" + std::to_string(::getpid()) + ".png");
+  r.write_png(file);
+  std::ifstream in(file, std::ios::binary);
+  char sig[8] = {};
+  in.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+  std::filesystem::remove(file);
+}
+
+TEST(GlRender, FrameWriterWritesEveryNthAndTheFinalFrame) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(8, 8);
+  const Params p = small_params();
+  auto pipe = make_gl("glsl-tf", {m, p, Integrator::verlet});
+  const auto dir = std::filesystem::temp_directory_path() / ("deformlab-frames-" + std::to_string(::getpid()));
+  {
+    gl::FrameWriter w(m, dir, 4, {64, 64});
+    for (int s = 1; s <= 10; ++s) {
+      pipe->step();
+      w.after_step(*pipe, s);
+    }
+    w.finish(*pipe, 10);
+    EXPECT_EQ(w.manifest()["frames"], 3);
+  }
+  for (const char* f : {"frame_000004.png", "frame_000008.png", "frame_000010.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace deformlab::test
