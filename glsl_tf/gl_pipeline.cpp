@@ -255,7 +255,6 @@ void GlPipeline::set_state(const State& s) {
     glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(data.size() * 4), data.data());
     glBindBuffer(GL_ARRAY_BUFFER, 0);
   };
-  glFinish();  // the buffers may still be read by queued passes
   upload(x_[cur_], s.x, true);
   upload(v_[cur_], s.v, false);
   has_prev_ = !s.x_prev.empty() && integrator_ == Integrator::verlet;
