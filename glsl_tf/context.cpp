@@ -62,10 +62,14 @@ class Context {
     }
     info_.debug = g_options.debug;
     if (const char* e = std::getenv("DEFORMLAB_GL_DEBUG"); e && std::string_view(e) == "1") info_.debug = true;
-    const EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
-                               EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                               EGL_CONTEXT_OPENGL_DEBUG, info_.debug ? EGL_TRUE : EGL_FALSE, EGL_NONE};
-    context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, ctx_attr);
+    // The newest core version first (NVIDIA gives exactly the version asked for), 4.3 last.
+    for (const EGLint minor : {6, 5, 3}) {
+      const EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, minor,
+                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                 EGL_CONTEXT_OPENGL_DEBUG, info_.debug ? EGL_TRUE : EGL_FALSE, EGL_NONE};
+      context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, ctx_attr);
+      if (context_ != EGL_NO_CONTEXT) break;
+    }
     if (context_ == EGL_NO_CONTEXT)
       fail(egl_error("creating an OpenGL 4.3 core context") + " on " + info_.platform +
            ": the driver may be too old for OpenGL 4.3");
