@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sys/wait.h>
 
 #include "gl_test_support.hpp"
@@ -72,6 +73,30 @@ TEST(GlErrors, MissingEglDisplayIsOneClearError) {
   EXPECT_EQ(list.exit_code, 0) << list.output;
   EXPECT_NE(list.output.find("glsl-tf        unavailable"), std::string::npos) << list.output;
   EXPECT_NE(list.output.find("why: OpenGL unavailable"), std::string::npos) << list.output;
+}
+
+TEST(GlErrors, UnknownGlDeviceIsBadInput) {
+  DEFORMLAB_REQUIRE_GL();
+  const auto dir = temp_dir("device");
+  const Command c = run_deformlab("", "run -p glsl-tf --grid 8x8 --steps 1 --gl-device 99 -o '" + (dir / "out").string() + "'");
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(c.exit_code, 2) << c.output;
+  EXPECT_NE(c.output.find("--gl-device 99 does not exist"), std::string::npos) << c.output;
+}
+
+// The command end to end: frames every N steps and the final one, committed with the run.
+TEST(GlCommand, RunWritesFramesAndGlFacts) {
+  DEFORMLAB_REQUIRE_GL();
+  const auto dir = temp_dir("run");
+  const Command c = run_deformlab("", "run -p glsl-compute --grid 16x16 --steps 12 --frames 5 -o '" + (dir / "out").string() + "'");
+  EXPECT_EQ(c.exit_code, 0) << c.output;
+  for (const char* f : {"frame_000005.png", "frame_000010.png", "frame_000012.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frames" / f)) << f;
+  std::ifstream manifest(dir / "out" / "manifest.json");
+  const std::string text((std::istreambuf_iterator<char>(manifest)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"renderer\""), std::string::npos) << "GL facts in the manifest";
+  EXPECT_NE(text.find("\"render_ms_median\""), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
