@@ -95,8 +95,9 @@ Model build_grid(Topology t, int nx, int ny, int nz, float h, const Material& ma
           m.spring_i.push_back(std::min(u, v));
           m.spring_j.push_back(std::max(u, v));
           m.kind.push_back(o.kind);
-          const Vec3d d = Vec3d(m.rest_position[u]) - Vec3d(m.rest_position[v]);
-          m.rest_length.push_back(float(norm(d)));
+          // From the offset, not the rounded positions: every spring of one offset shares
+          // one rest length, which grid kernels rely on.
+          m.rest_length.push_back(float(double(h) * std::sqrt(double(o.di * o.di + o.dj * o.dj + o.dk * o.dk))));
         }
   m.build_adjacency();
   return m;

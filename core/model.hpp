@@ -27,7 +27,7 @@ struct Model {
   std::vector<float> inv_mass;       // [n] 1/m; 0 marks a pinned node
 
   std::vector<std::int32_t> spring_i, spring_j;  // [s] end nodes, i < j
-  std::vector<float> rest_length;                // [s] from the builder's rest positions
+  std::vector<float> rest_length;                // [s] grids: spacing x |offset|, one value per offset
   std::vector<SpringKind> kind;                  // [s]
   std::array<float, kSpringKinds> stiffness{};   // per kind, N/m
   std::array<float, kSpringKinds> damping{};     // per kind, along the spring axis, N s/m

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "core/model.hpp"
 
@@ -53,12 +54,15 @@ TEST(Builders, RestLengthsAndAdjacencyAreConsistent) {
   const Model m = lattice(4, 3, 5, h, 1.f, Material{});
   for (int s = 0; s < m.spring_count(); ++s) {
     const float len = norm(m.rest_position[m.spring_i[s]] - m.rest_position[m.spring_j[s]]);
-    EXPECT_FLOAT_EQ(m.rest_length[s], len);
+    EXPECT_NEAR(m.rest_length[s], len, 1e-6f);  // the rest state is (to rounding) unstressed
     const float expect = m.kind[s] == SpringKind::structural ? h : m.kind[s] == SpringKind::flexion ? 2 * h : 0.f;
     if (expect > 0.f) EXPECT_NEAR(m.rest_length[s], expect, 1e-6f);
     else EXPECT_TRUE(std::abs(m.rest_length[s] - h * std::sqrt(2.f)) < 1e-6f ||
                      std::abs(m.rest_length[s] - h * std::sqrt(3.f)) < 1e-6f);
   }
+  // One rest length per offset kind: structural h, flexion 2h, face sqrt(2) h, body sqrt(3) h.
+  std::set<float> lengths(m.rest_length.begin(), m.rest_length.end());
+  EXPECT_EQ(lengths.size(), 4u);
   // Every spring appears once in each end's adjacency, pointing at the other end.
   ASSERT_EQ(m.adj_offset.back(), 2 * m.spring_count());
   for (int v = 0; v < m.node_count(); ++v)
