@@ -10,6 +10,7 @@
 #include "integrator.hpp"
 #include "model.hpp"
 #include "params.hpp"
+#include "profiler.hpp"
 #include "state.hpp"
 
 namespace deformlab {
@@ -25,6 +26,9 @@ class Pipeline {
   virtual double max_displacement() = 0;
   // How step times are measured ("host clock", "CUDA events", "GL timer queries").
   virtual std::string timing_method() const { return "host clock (steady_clock)"; }
+  // Pipelines that time their stages add spans (force, hand-off, update, ...) to `p` from
+  // now on; null stops it. The default records nothing.
+  virtual void set_profiler(Profiler* p) { (void)p; }
 };
 
 // Per-pipeline settings by name, e.g. {"tile": "16x8"} or {"interop": "map"}; each

@@ -26,9 +26,14 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
   const double runaway = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
+  pipe.set_profiler(opt.profiler);
   for (int step = 1; step <= p.max_steps; ++step) {
+    if (opt.profiler) opt.profiler->set_step(step);
     const auto t0 = clock::now();
-    pipe.step();
+    {
+      HostSpan span(opt.profiler, span::step);
+      pipe.step();
+    }
     const double ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     const double t = step * double(p.dt);
     r.total_ms += ms;
@@ -36,6 +41,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     double disp = std::numeric_limits<double>::quiet_NaN();
     const bool check = step % p.check_every == 0 || step == p.max_steps;
     if (check) {
+      HostSpan span(opt.profiler, span::reductions);
       disp = pipe.max_displacement();
       r.last_displacement = disp;
       if (!std::isfinite(disp) || disp > runaway) {
@@ -58,6 +64,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
       break;
     }
   }
+  pipe.set_profiler(nullptr);  // collects the spans still pending
   return r;
 }
 

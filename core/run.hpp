@@ -43,6 +43,8 @@ struct RunOptions {
   bool until_converged = false;  // else run exactly params.max_steps steps
   // Called after every step (e.g. to write frames); may be empty.
   std::function<void(int step)> after_step;
+  // When set: the pipeline's own stage spans, plus "step" and "reductions" on the host clock.
+  Profiler* profiler = nullptr;
 };
 
 // Throws DivergenceError naming the step, what was seen and the stability limit.

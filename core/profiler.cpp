@@ -1,0 +1,99 @@
+#include "profiler.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#if DEFORMLAB_NVTX
+#include <nvtx3/nvToolsExt.h>
+#endif
+
+namespace deformlab {
+
+Profiler::Profiler() : t0_(std::chrono::steady_clock::now()) {}
+
+double Profiler::now_ms() const {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+void Profiler::add(Span s) { spans_.push_back(std::move(s)); }
+
+std::vector<Profiler::Stage> Profiler::summary() const {
+  std::vector<Stage> out;
+  std::map<std::string, std::map<int, double>> per_step;  // name -> step -> summed ms
+  for (const Span& s : spans_) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const Stage& g) { return g.name == s.name; });
+    if (it == out.end()) {
+      out.push_back({s.name, s.clock});
+      it = out.end() - 1;
+    } else if (it->clock != s.clock && it->clock.find(s.clock) == std::string::npos) {
+      it->clock += ", " + s.clock;
+    }
+    ++it->spans;
+    it->total_ms += s.ms;
+    per_step[s.name][s.step] += s.ms;
+  }
+  for (Stage& g : out) {
+    std::vector<double> v;
+    for (const auto& [step, ms] : per_step[g.name]) v.push_back(ms);
+    g.steps = int(v.size());
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    g.median_ms = v[v.size() / 2];
+  }
+  return out;
+}
+
+void Profiler::write_csv(const std::string& path) const {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
+  for (const Span& s : spans_) f << s.name << ',' << s.step << ',' << s.start_ms << ',' << s.ms << ",\"" << s.clock << "\"\n";
+  if (!f) throw std::runtime_error("writing " + path + " failed");
+}
+
+void Profiler::write_trace(const std::string& path) const {
+  // One track (tid) per clock, named by metadata events.
+  std::vector<std::string> clocks;
+  nlohmann::json events = nlohmann::json::array();
+  for (const Span& s : spans_) {
+    auto it = std::find(clocks.begin(), clocks.end(), s.clock);
+    if (it == clocks.end()) {
+      clocks.push_back(s.clock);
+      it = clocks.end() - 1;
+      events.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 1}, {"tid", int(it - clocks.begin()) + 1},
+                        {"args", {{"name", s.clock}}}});
+    }
+    events.push_back({{"name", s.name},
+                      {"cat", s.clock},
+                      {"ph", "X"},
+                      {"pid", 1},
+                      {"tid", int(it - clocks.begin()) + 1},
+                      {"ts", s.start_ms * 1000.0},
+                      {"dur", s.ms * 1000.0},
+                      {"args", {{"step", s.step}}}});
+  }
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << nlohmann::json{{"traceEvents", events}, {"displayTimeUnit", "ms"}}.dump() << "\n";
+  if (!f) throw std::runtime_error("writing " + path + " failed");
+}
+
+#if DEFORMLAB_NVTX
+NvtxRange::NvtxRange(const char* name) { nvtxRangePushA(name); }
+NvtxRange::~NvtxRange() { nvtxRangePop(); }
+#else
+NvtxRange::NvtxRange(const char*) {}
+NvtxRange::~NvtxRange() = default;
+#endif
+
+HostSpan::HostSpan(Profiler* p, const char* name)
+    : p_(p), name_(name), start_(p ? p->now_ms() : 0.0), range_(name) {}
+
+HostSpan::~HostSpan() {
+  if (p_) p_->add({name_, p_->step(), start_, p_->now_ms() - start_, "host clock"});
+}
+
+}  // namespace deformlab

@@ -1,0 +1,89 @@
+// Profiling: named spans for the stages and hand-offs of each step, each timed by the clock
+// that is true for it (CUDA events for CUDA work, GL timer queries for GL work, the host
+// clock for what the CPU does or waits for), written as CSV and as a Chrome trace JSON that
+// opens in Perfetto. NVTX ranges with the same names mark the host side for Nsight (the
+// NVTX header is header-only; the ranges cost nothing unless a tool is attached).
+#pragma once
+#include <chrono>
+#include <string>
+#include <vector>
+
+namespace deformlab {
+
+// Span names shared by every pipeline.
+namespace span {
+inline constexpr const char* step = "step";
+inline constexpr const char* force = "force";
+inline constexpr const char* hand_off = "hand-off";
+inline constexpr const char* update = "update";
+inline constexpr const char* constraints = "constraints";
+inline constexpr const char* reductions = "reductions";
+inline constexpr const char* render = "render";
+}  // namespace span
+
+struct Span {
+  std::string name;
+  int step = 0;           // the step the span belongs to (0: before the first step)
+  double start_ms = 0.0;  // host clock when its work was issued, ms since the profiler started
+  double ms = 0.0;        // duration, ms
+  std::string clock;      // how `ms` was measured ("CUDA events", "GL timer queries", "host clock")
+};
+
+class Profiler {
+ public:
+  Profiler();
+  // Host clock, ms since the profiler was made.
+  double now_ms() const;
+  void set_step(int step) { step_ = step; }
+  int step() const { return step_; }
+  void add(Span s);
+  const std::vector<Span>& spans() const { return spans_; }
+
+  // Per span name, in the order names first appear: the spans of one step summed (RK4 has
+  // four force passes), then the median over the steps that have the span.
+  struct Stage {
+    std::string name, clock;
+    int steps = 0;           // steps with this span
+    int spans = 0;           // spans in all
+    double median_ms = 0.0;  // per step
+    double total_ms = 0.0;
+  };
+  std::vector<Stage> summary() const;
+
+  // name,step,start_ms,ms,clock, one line per span.
+  void write_csv(const std::string& path) const;
+  // Chrome trace JSON (complete events; one track per clock), opens in Perfetto. GPU spans
+  // are placed at the host time their work was issued, with their GPU-measured durations.
+  void write_trace(const std::string& path) const;
+
+ private:
+  std::chrono::steady_clock::time_point t0_;
+  std::vector<Span> spans_;
+  int step_ = 0;
+};
+
+// An NVTX range named like the span it covers, for as long as the object lives.
+class NvtxRange {
+ public:
+  explicit NvtxRange(const char* name);
+  ~NvtxRange();
+  NvtxRange(const NvtxRange&) = delete;
+  NvtxRange& operator=(const NvtxRange&) = delete;
+};
+
+// A span timed by the host clock, with its NVTX range; records nothing when `p` is null.
+class HostSpan {
+ public:
+  HostSpan(Profiler* p, const char* name);
+  ~HostSpan();
+  HostSpan(const HostSpan&) = delete;
+  HostSpan& operator=(const HostSpan&) = delete;
+
+ private:
+  Profiler* p_;
+  const char* name_;
+  double start_ = 0.0;
+  NvtxRange range_;
+};
+
+}  // namespace deformlab

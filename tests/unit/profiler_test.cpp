@@ -1,0 +1,91 @@
+// The profiler's span model, summary and writers; and the run loop's spans.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+
+#include "core/cpu_backend.hpp"
+#include "core/profiler.hpp"
+#include "core/run.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+TEST(Profiler, SummarySumsSpansPerStepThenTakesTheMedian) {
+  Profiler p;
+  // Two force passes per step (as midpoint): 1 + 2, 5 + 6, 9 + 10 ms -> per step 3, 11, 19.
+  for (int step = 1; step <= 3; ++step) {
+    p.add({span::force, step, 0.0, 4.0 * step - 3.0, "CUDA events"});
+    p.add({span::force, step, 0.0, 4.0 * step - 2.0, "CUDA events"});
+    p.add({span::update, step, 0.0, 0.5, "GL timer queries"});
+  }
+  const auto s = p.summary();
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].name, "force");
+  EXPECT_EQ(s[0].steps, 3);
+  EXPECT_EQ(s[0].spans, 6);
+  EXPECT_DOUBLE_EQ(s[0].median_ms, 11.0);
+  EXPECT_DOUBLE_EQ(s[0].total_ms, 33.0);
+  EXPECT_EQ(s[0].clock, "CUDA events");
+  EXPECT_EQ(s[1].name, "update");
+  EXPECT_DOUBLE_EQ(s[1].median_ms, 0.5);
+}
+
+TEST(Profiler, WritesCsvAndAChromeTrace) {
+  Profiler p;
+  p.set_step(1);
+  { HostSpan h(&p, span::step); }
+  p.add({span::force, 1, 0.25, 0.125, "CUDA events"});
+  const auto dir = std::filesystem::temp_directory_path() / ("deformlab_profiler_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  p.write_csv((dir / "spans.csv").string());
+  p.write_trace((dir / "trace.json").string());
+  std::ifstream csv(dir / "spans.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "name,step,start_ms,ms,clock");
+  int lines = 0;
+  while (std::getline(csv, line)) ++lines;
+  EXPECT_EQ(lines, 2);
+  std::ifstream tf(dir / "trace.json");
+  const auto j = nlohmann::json::parse(tf);
+  int complete = 0;
+  for (const auto& e : j["traceEvents"]) {
+    if (e["ph"] != "X") continue;
+    ++complete;
+    if (e["name"] == "force") {
+      EXPECT_DOUBLE_EQ(e["ts"].get<double>(), 250.0);  // microseconds
+      EXPECT_DOUBLE_EQ(e["dur"].get<double>(), 125.0);
+    }
+  }
+  EXPECT_EQ(complete, 2);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Profiler, RunRecordsStepAndReductionSpans) {
+  const Model m = small_cloth(6, 6);
+  Params p = small_params();
+  p.max_steps = 5;
+  p.check_every = 1;
+  auto pipe = make_cpu_pipeline({m, p, Integrator::semi_implicit_euler}, Precision::f32, false);
+  Profiler prof;
+  RunOptions opt;
+  opt.profiler = &prof;
+  run(*pipe, m, p, opt);
+  int steps = 0, reductions = 0;
+  for (const Span& s : prof.spans()) {
+    steps += s.name == span::step;
+    reductions += s.name == span::reductions;
+    EXPECT_EQ(s.clock, "host clock");
+    EXPECT_GE(s.step, 1);
+  }
+  EXPECT_EQ(steps, 5);
+  EXPECT_EQ(reductions, 5);
+}
+
+}  // namespace
+}  // namespace deformlab::test
