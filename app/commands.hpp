@@ -18,6 +18,12 @@ struct RunArgs {
   std::optional<std::string> out;
   std::optional<int> frames;     // render a frame every N steps into DIR/frames (GL builds)
   std::optional<int> gl_device;  // EGL device index for the GL context (GL builds)
+  bool trace = false;            // also write trace.json (Chrome trace of the spans)
+};
+
+struct CalibrateArgs {
+  std::vector<std::string> argv;
+  std::optional<std::string> out;  // JSON file (default: stdout)
 };
 
 struct ExperimentArgs {
@@ -34,5 +40,6 @@ int report_errors(const std::function<int()>& body);
 int run_command(const RunArgs& a);
 int experiment_command(const ExperimentArgs& a);
 int list_command();
+int calibrate_command(const CalibrateArgs& a);
 
 }  // namespace deformlab::app

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
   run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)");
+  run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");
 
   deformlab::app::ExperimentArgs ex;
   ex.argv = a.argv;
@@ -54,6 +55,12 @@ int main(int argc, char** argv) {
   experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
 
   auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");
+
+  deformlab::app::CalibrateArgs cal;
+  cal.argv = a.argv;
+  auto* calibrate = cli.add_subcommand(
+      "calibrate", "Measure this device's ceilings (copy, transform feedback, compute, interop hand-offs) as JSON");
+  calibrate->add_option("--out,-o", cal.out, "JSON file to write (default: standard output)");
 
   try {
     cli.parse(argc, argv);
@@ -68,5 +75,6 @@ int main(int argc, char** argv) {
   if (*run) return deformlab::app::run_command(a);
   if (*experiment) return deformlab::app::experiment_command(ex);
   if (*list) return deformlab::app::list_command();
+  if (*calibrate) return deformlab::app::calibrate_command(cal);
   return 2;
 }

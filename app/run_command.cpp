@@ -161,11 +161,16 @@ int run_command(const RunArgs& a) {
     pipe->set_state(rest_state(model));
     RunOptions opt;
     opt.until_converged = until_converged;
+    Profiler profiler;
+    opt.profiler = &profiler;
 #if DEFORMLAB_GL_RENDER
     std::optional<gl::FrameWriter> frames;
     if (a.frames) {
       frames.emplace(model, dir.staged("frames"), *a.frames);
-      opt.after_step = [&](int step) { frames->after_step(*pipe, step); };
+      opt.after_step = [&](int step) {
+        HostSpan span(&profiler, span::render);
+        frames->after_step(*pipe, step);
+      };
     }
 #endif
     const RunResult r = run(*pipe, model, params, opt);
@@ -192,6 +197,12 @@ int run_command(const RunArgs& a) {
     const double limit = explicit_stability_limit(model, params);
 
     write_timings_csv(dir.staged("timings.csv"), r);
+    profiler.write_csv(dir.staged("spans.csv").string());
+    if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
+    nlohmann::json stages = nlohmann::json::array();
+    for (const auto& g : profiler.summary())
+      stages.push_back({{"name", g.name}, {"median_ms_per_step", g.median_ms}, {"steps", g.steps},
+                        {"spans", g.spans}, {"total_ms", g.total_ms}, {"clock", g.clock}});
     write_ply(dir.staged("state.ply"), model, final_state);
     nlohmann::json scene = to_json(x.scene);
     nlohmann::json manifest = {
@@ -207,11 +218,14 @@ int run_command(const RunArgs& a) {
         {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * double(params.dt)},
                     {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                     {"median_step_ms", med}, {"timing_method", pipe->timing_method()}}},
+        {"stages", stages},
         {"files", {{"timings.csv", "per step: step, t_s, step_ms (wall), max_displacement_m"},
+                   {"spans.csv", "per span: name, step, start_ms (host clock), ms, clock (how it was timed)"},
                    {"state.ply", "final state: binary little-endian PLY, vertex x y z (m) vx vy vz (m/s)"}}},
         {"build", build_info()},
         {"machine", machine_info()}};
     if (a.compare) manifest["compare"] = compare;
+    if (a.trace) manifest["files"]["trace.json"] = "Chrome trace of the spans (open in Perfetto: ui.perfetto.dev)";
 #if DEFORMLAB_GL_RENDER
     if (frames) manifest["frames"] = frames->manifest();
     if (auto g = gl::run_manifest(*pipe); !g.is_null()) manifest["gl"] = g;
@@ -234,7 +248,12 @@ int run_command(const RunArgs& a) {
     if (a.compare)
       std::cout << "  compare: largest position error vs the double reference: " << compare_err
                 << " of the model's extent\n";
-    std::cout << "  wrote " << dir.dir().string() << "/{timings.csv, state.ply, manifest.json}\n";
+    std::cout << "  where a step's time goes (median per step):\n";
+    for (const auto& g : profiler.summary())
+      std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
+                << " ms  (" << g.clock << ")\n";
+    std::cout << "  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, state.ply, manifest.json"
+              << (a.trace ? ", trace.json" : "") << "}\n";
     return 0;
   });
 }
