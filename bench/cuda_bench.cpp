@@ -134,7 +134,7 @@ void run_cuda(const CudaOptions& o) {
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);
-  std::cout << "\n[steps] " << o.integrator << ", tile 32x8, step graphs on\n"
+  std::cout << "\n[steps] " << o.integrator << ", tile 16x8, step graphs on\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
             << "B/node" << std::setw(10) << "GB/s" << std::setw(10) << "of copy" << "\n";
   for (int n : o.sizes) {
@@ -147,7 +147,7 @@ void run_cuda(const CudaOptions& o) {
     }
   }
 
-  std::cout << "\n[graphs] launch overhead: ms/step with and without the step captured as a CUDA graph ("
+  if (!o.graph_sizes.empty()) std::cout << "\n[graphs] launch overhead: ms/step with and without the step captured as a CUDA graph ("
             << o.integrator << ")\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "graph" << std::setw(12)
             << "launches" << std::setw(10) << "gain" << "\n";
@@ -171,7 +171,8 @@ void run_cuda(const CudaOptions& o) {
       const cuda::Tile tile = cuda::parse_tile(t);
       std::cout << std::setw(8) << t;
       for (cuda::Variant v : {cuda::Variant::tiled, cuda::Variant::naive, cuda::Variant::fused})
-        std::cout << std::setw(12) << fixed(rep.measure("tiles", m, integ, {v, tile, true}, o).ms, 4);
+        std::cout << std::setw(12)
+                  << fixed(rep.measure("tiles", m, integ, {v, tile, true}, o).ms, 4);
       std::cout << "\n";
     }
   }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <stdexcept>
 
 #include "check.cuh"
@@ -70,8 +71,9 @@ Stencil make_stencil(const Model& m) {
     st.di[count] = std::int8_t(sign * h.di);
     st.dj[count] = std::int8_t(sign * h.dj);
     st.dk[count] = std::int8_t(sign * h.dk);
-    st.kind[count] = std::uint8_t(h.kind);
     st.rest[count] = h.rest;
+    st.k[count] = m.stiffness[h.kind];
+    st.kd[count] = m.damping[h.kind];
     ++count;
   };
   for (const auto& h : in) put(h, -1);
@@ -176,6 +178,12 @@ class Impl final : public CudaPipeline {
 
     if (grid_) {
       stencil_ = make_stencil(m);
+      const int full = scene_.nz > 1 ? dev::kMaxStencil : 12;
+      canonical_ = stencil_.count == full;
+      for (int e = 0; e < stencil_.count && canonical_; ++e) {
+        const dev::Offset o = dev::canonical_offset(full, e);
+        canonical_ = o.di == stencil_.di[e] && o.dj == stencil_.dj[e] && o.dk == stencil_.dk[e];
+      }
     } else if (o_.variant != Variant::scatter) {
       std::vector<Link> links(m.adj_node.size());
       for (std::size_t e = 0; e < links.size(); ++e) {
@@ -381,26 +389,37 @@ class Impl final : public CudaPipeline {
     }
   }
 
-  template <int N, bool Damped, bool Tiled>
+  // Calls f(N, Damped, Canonical) with the grid kernels' compile-time flags for this model.
+  template <class F>
+  void with_grid_flags(F&& f) const {
+    using std::bool_constant;
+    using std::integral_constant;
+    auto canon = [&](auto n, auto damped) {
+      if (canonical_) f(n, damped, bool_constant<true>{});
+      else f(n, damped, bool_constant<false>{});
+    };
+    auto damp = [&](auto n) {
+      if (damped_) canon(n, bool_constant<true>{});
+      else canon(n, bool_constant<false>{});
+    };
+    if (scene_.nz > 1) damp(integral_constant<int, dev::kMaxStencil>{});
+    else damp(integral_constant<int, 12>{});
+  }
+
+  template <int N, bool Damped, bool Canonical, bool Tiled>
   void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target) {
+    const auto kernel = dev::force_grid<N, Damped, Canonical, Tiled>;
     std::size_t shared = 0;
     if (Tiled) {
       const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
                                 (N > 12 ? 2 * dev::kHalo + 1 : 1);
       shared = cells * sizeof(float4) * (Damped ? 2 : 1);
       if (shared > 48 * 1024)
-        check(cudaFuncSetAttribute(dev::force_grid<N, Damped, Tiled>, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                                   int(shared)),
+        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
               "raising the tiled kernel's shared-memory limit");
     }
-    dev::force_grid<N, Damped, Tiled><<<grid_blocks(), grid_threads(), shared, stream_>>>(scene_, stencil_, x, v, acc, target);
+    kernel<<<grid_blocks(), grid_threads(), shared, stream_>>>(scene_, stencil_, x, v, acc, target);
     check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
-  }
-
-  template <int N, bool Tiled>
-  void force_grid_dispatch(const float4* x, const float4* v, float4* acc, Vec3f target) {
-    if (damped_) launch_force_grid<N, true, Tiled>(x, v, acc, target);
-    else launch_force_grid<N, false, Tiled>(x, v, acc, target);
   }
 
   void force_pass(int src, int slot, Vec3f target) {
@@ -423,13 +442,10 @@ class Impl final : public CudaPipeline {
       return;
     }
     const bool tiled = o_.variant == Variant::tiled;
-    if (scene_.nz > 1) {
-      if (tiled) force_grid_dispatch<dev::kMaxStencil, true>(x, v, acc, target);
-      else force_grid_dispatch<dev::kMaxStencil, false>(x, v, acc, target);
-    } else {
-      if (tiled) force_grid_dispatch<12, true>(x, v, acc, target);
-      else force_grid_dispatch<12, false>(x, v, acc, target);
-    }
+    with_grid_flags([&](auto n, auto damped, auto canonical) {
+      if (tiled) launch_force_grid<n(), damped(), canonical(), true>(x, v, acc, target);
+      else launch_force_grid<n(), damped(), canonical(), false>(x, v, acc, target);
+    });
   }
 
   template <Integrator I>
@@ -472,10 +488,10 @@ class Impl final : public CudaPipeline {
     check_launch("launching the combine kernel");
   }
 
-  template <int N, bool Damped, Integrator I>
+  template <int N, bool Damped, bool Canonical, Integrator I>
   void launch_fused_grid(const Targets& tg) {
     const int nxt = 1 - cur_;
-    dev::fused_grid<N, Damped, I><<<grid_blocks(), grid_threads(), 0, stream_>>>(
+    dev::fused_grid<N, Damped, Canonical, I><<<grid_blocks(), grid_threads(), 0, stream_>>>(
         scene_, stencil_, x_[cur_].get(), v_[cur_].get(), x_[nxt].get(), has_prev_, x_[nxt].get(), v_[nxt].get(), tg);
     check_launch("launching the fused step kernel");
   }
@@ -488,12 +504,10 @@ class Impl final : public CudaPipeline {
                                                                 v_[cur_].get(), x_[nxt].get(), has_prev_,
                                                                 x_[nxt].get(), v_[nxt].get(), tg);
       check_launch("launching the fused CSR step kernel");
-    } else if (scene_.nz > 1) {
-      if (damped_) launch_fused_grid<dev::kMaxStencil, true, I>(tg);
-      else launch_fused_grid<dev::kMaxStencil, false, I>(tg);
     } else {
-      if (damped_) launch_fused_grid<12, true, I>(tg);
-      else launch_fused_grid<12, false, I>(tg);
+      with_grid_flags([&](auto n, auto damped, auto canonical) {
+        launch_fused_grid<n(), damped(), canonical(), I>(tg);
+      });
     }
   }
   void fused_step() {
@@ -510,7 +524,7 @@ class Impl final : public CudaPipeline {
   Schedule sched_;
   Options o_;
   int n_ = 0;
-  bool grid_ = false, fused_ = false, damped_ = false;
+  bool grid_ = false, fused_ = false, damped_ = false, canonical_ = false;
   Scene scene_;
   Stencil stencil_{};
 

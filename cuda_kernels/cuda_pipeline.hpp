@@ -21,7 +21,7 @@ const char* to_string(Variant v);
 // Thread-block shape over a grid's (i, j) plane for the gather kernels (one node per
 // thread); cuda-tiled stages the block's nodes plus a 2-node halo in shared memory.
 struct Tile {
-  int x = 32, y = 8;
+  int x = 16, y = 8;
 };
 // "WxH" -> Tile; throws std::invalid_argument on anything else.
 Tile parse_tile(const std::string& s);

@@ -15,12 +15,12 @@ namespace deformlab::cuda::dev {
 constexpr int kMaxStencil = 32;  // lattice: 6 structural + 20 shear + 6 flexion
 
 // A grid's neighbour offsets in the order of the CPU's adjacency lists (incident springs by
-// spring index), with one rest length per offset.
+// spring index), with one rest length per offset and the offset's spring constants (read
+// straight from the kernel parameters).
 struct Stencil {
   int count;  // entries in use (offsets that occur in the model)
   std::int8_t di[kMaxStencil], dj[kMaxStencil], dk[kMaxStencil];
-  std::uint8_t kind[kMaxStencil];
-  float rest[kMaxStencil];
+  float rest[kMaxStencil], k[kMaxStencil], kd[kMaxStencil];
 };
 
 struct Link {  // one CSR entry: the spring's other end
@@ -85,22 +85,71 @@ struct Window {
   __device__ __forceinline__ int at(int di, int dj, int dk) const { return base + di + dj * stride_j + dk * stride_k; }
 };
 
-// Sum of spring forces on grid node (i, j, k) from its N stencil neighbours. Undamped
-// springs do not read the neighbours' velocities (kd = 0 makes the term 0 either way).
-template <int N, bool Damped>
-__device__ __forceinline__ Vec3f gather_grid(const Scene& s, const Stencil& st, int i, int j, int k,
-                                             const Vec3f& xi, const Vec3f& vi, const Window& w) {
+struct Offset {
+  int di, dj, dk;
+};
+
+// The stencil order of grids at least 4 nodes wide (5 for lattices) is always the same; with
+// it as compile-time constants the index arithmetic and the bounds checks fold away.
+// Cloth: the 6 springs from lower-numbered nodes, then the node's own 6.
+__host__ __device__ constexpr Offset canonical_offset(int n, int e) {
+  constexpr Offset cloth[12] = {{0, -2, 0}, {-1, -1, 0}, {0, -1, 0}, {1, -1, 0}, {-2, 0, 0}, {-1, 0, 0},
+                                {1, 0, 0},  {-1, 1, 0},  {0, 1, 0},  {1, 1, 0},  {2, 0, 0},  {0, 2, 0}};
+  constexpr Offset lattice[32] = {
+      {0, 0, -2},  {-1, -1, -1}, {0, -1, -1}, {1, -1, -1}, {-1, 0, -1}, {0, 0, -1}, {1, 0, -1},  {-1, 1, -1},
+      {0, 1, -1},  {1, 1, -1},   {0, -2, 0},  {-1, -1, 0}, {0, -1, 0},  {1, -1, 0}, {-2, 0, 0},  {-1, 0, 0},
+      {1, 0, 0},   {-1, 1, 0},   {0, 1, 0},   {1, 1, 0},   {-1, -1, 1}, {0, -1, 1}, {1, -1, 1},  {-1, 0, 1},
+      {0, 0, 1},   {1, 0, 1},    {-1, 1, 1},  {0, 1, 1},   {1, 1, 1},   {2, 0, 0},  {0, 2, 0},   {0, 0, 2}};
+  return n == 12 ? cloth[e] : lattice[e];
+}
+
+// Sum of spring forces on grid node (i, j, k) from its N stencil neighbours. Canonical: the
+// offsets are canonical_offset(N, .). Checked: some neighbours may lie outside the grid
+// (nodes within 2 of a border). Undamped springs do not read the neighbours' velocities
+// (kd = 0 makes the damping term 0 either way). The neighbours are loaded a group at a time
+// before their springs are computed, so that the loads are in flight together.
+template <int N, bool Damped, bool Canonical, bool Checked>
+__device__ __forceinline__ Vec3f gather_stencil(const Scene& s, const Stencil& st, int i, int j, int k,
+                                                const Vec3f& xi, const Vec3f& vi, const Window& w) {
+  constexpr int G = N <= 12 ? 6 : 8;  // group size: bounded register use
   Vec3f f{};
 #pragma unroll
-  for (int e = 0; e < N; ++e) {
-    if (e >= st.count) break;
-    const int a = i + st.di[e], b = j + st.dj[e], c = k + st.dk[e];
-    if (a < 0 || a >= s.nx || b < 0 || b >= s.ny || c < 0 || c >= s.nz) continue;
-    const int q = w.at(st.di[e], st.dj[e], st.dk[e]);
-    const Vec3f vj = Damped ? xyz(w.v[q]) : vi;
-    f += spring_force(xi, xyz(w.x[q]), vi, vj, pick(s.k, st.kind[e]), pick(s.kd, st.kind[e]), st.rest[e]);
+  for (int g = 0; g < N; g += G) {
+    float4 xn[G], vn[Damped ? G : 1];
+    bool ok[G];
+#pragma unroll
+    for (int q = 0; q < G; ++q) {
+      const int e = g + q;
+      const Offset o = Canonical ? canonical_offset(N, e) : Offset{st.di[e], st.dj[e], st.dk[e]};
+      ok[q] = Canonical || e < st.count;
+      if (Checked) {
+        const int a = i + o.di, b = j + o.dj, c = k + o.dk;
+        ok[q] = ok[q] && a >= 0 && a < s.nx && b >= 0 && b < s.ny && c >= 0 && c < s.nz;
+      }
+      if (ok[q]) {
+        const int at = w.at(o.di, o.dj, o.dk);
+        xn[q] = w.x[at];
+        if (Damped) vn[q] = w.v[at];
+      }
+    }
+#pragma unroll
+    for (int q = 0; q < G; ++q) {
+      if (!ok[q]) continue;
+      const int e = g + q;
+      const Vec3f vj = Damped ? xyz(vn[Damped ? q : 0]) : vi;
+      f += spring_force(xi, xyz(xn[q]), vi, vj, st.k[e], st.kd[e], st.rest[e]);
+    }
   }
   return f;
+}
+
+// The gather with bounds checks only for nodes within 2 of a border.
+template <int N, bool Damped, bool Canonical>
+__device__ __forceinline__ Vec3f gather_grid(const Scene& s, const Stencil& st, int i, int j, int k,
+                                             const Vec3f& xi, const Vec3f& vi, const Window& w) {
+  const bool inside = i >= 2 && i < s.nx - 2 && j >= 2 && j < s.ny - 2 && (N == 12 || (k >= 2 && k < s.nz - 2));
+  if (Canonical && inside) return gather_stencil<N, Damped, true, false>(s, st, i, j, k, xi, vi, w);
+  return gather_stencil<N, Damped, Canonical, true>(s, st, i, j, k, xi, vi, w);
 }
 
 // Sum of spring forces on node i from its CSR adjacency (general models).
@@ -168,6 +217,11 @@ __device__ __forceinline__ void advance_node(const Scene& s, int i, const float4
 
 // ---- grid kernels: block (tile.x, tile.y) over (i, j), grid.z over layers k ----
 
+// Register cap of the grid gather kernels: the compiler's choice (about 80) limits an SM to
+// 3 blocks of 256 threads; the gather is issue-bound, and more resident warps hide its
+// latencies better (measured on the H100: 48 beats 64 and 80).
+constexpr int kGatherRegisters = 48;
+
 // Halo of the shared tile: flexion springs reach two nodes.
 constexpr int kHalo = 2;
 
@@ -192,8 +246,8 @@ __device__ __forceinline__ Window load_tile(const Scene& s, const float4* __rest
 }
 
 // Force pass on a grid: acc = a(x, v). Tiled: neighbours from a shared tile.
-template <int N, bool Damped, bool Tiled>
-__global__ void force_grid(Scene s, Stencil st, const float4* __restrict__ x, const float4* __restrict__ v,
+template <int N, bool Damped, bool Canonical, bool Tiled>
+__global__ void __maxnreg__(kGatherRegisters) force_grid(Scene s, Stencil st, const float4* __restrict__ x, const float4* __restrict__ v,
                            float4* __restrict__ acc, Vec3f drag_target) {
   extern __shared__ float4 sh[];
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y, k = blockIdx.z;
@@ -206,15 +260,15 @@ __global__ void force_grid(Scene s, Stencil st, const float4* __restrict__ x, co
   Vec3f a{};
   if (!fixed(s, node, x4.w)) {
     const Vec3f xi = xyz(x4), vi = xyz(v4);
-    a = node_accel(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), drag_target);
+    a = node_accel(s, node, x4.w, xi, vi, gather_grid<N, Damped, Canonical>(s, st, i, j, k, xi, vi, w), drag_target);
   }
   acc[node] = f4(a, 0.f);
 }
 
 // Force, update and constraints in one kernel (one-force-pass integrators): reads (x, v)
 // and x_prev (Verlet), writes (xo, vo). x_prev may alias xo.
-template <int N, bool Damped, Integrator I>
-__global__ void fused_grid(Scene s, Stencil st, const float4* __restrict__ x, const float4* __restrict__ v,
+template <int N, bool Damped, bool Canonical, Integrator I>
+__global__ void __maxnreg__(kGatherRegisters) fused_grid(Scene s, Stencil st, const float4* __restrict__ x, const float4* __restrict__ v,
                            const float4* x_prev, bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y, k = blockIdx.z;
   if (i >= s.nx || j >= s.ny) return;
@@ -224,7 +278,7 @@ __global__ void fused_grid(Scene s, Stencil st, const float4* __restrict__ x, co
   if (!fixed(s, node, x4.w)) {
     const Vec3f xi = xyz(x4), vi = xyz(v4);
     const Window w{x, v, node, s.nx, s.nx * s.ny};
-    a = node_accel(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), tg.force);
+    a = node_accel(s, node, x4.w, xi, vi, gather_grid<N, Damped, Canonical>(s, st, i, j, k, xi, vi, w), tg.force);
   }
   advance_node<I>(s, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
 }

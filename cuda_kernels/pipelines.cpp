@@ -97,7 +97,7 @@ void add_cuda_pipelines(PipelineRegistry& r) {
   const Entry entries[] = {
       {"cuda-naive", Variant::naive, true, "CUDA, one thread per node gathering its springs from global memory"},
       {"cuda-tiled", Variant::tiled, true,
-       "CUDA, gather from a shared-memory tile with a 2-node halo (tile: DEFORMLAB_CUDA_TILE=WxH, default 32x8)"},
+       "CUDA, gather from a shared-memory tile with a 2-node halo (tile: DEFORMLAB_CUDA_TILE=WxH, default 16x8)"},
       {"cuda-scatter", Variant::scatter, false,
        "CUDA, one thread per spring, atomic scatter of +f/-f"},
       {"cuda-fused", Variant::fused, true,

@@ -9,7 +9,8 @@ namespace {
 
 using cuda::Variant;
 
-constexpr int kSteps = 30;  // the drag path ends after 10: later steps replay a CUDA graph
+constexpr int kSteps = 30;
+constexpr Variant kVariants[] = {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused};  // the drag path ends after 10: later steps replay a CUDA graph
 
 struct Scene {
   Model m;
@@ -61,10 +62,10 @@ TEST(CudaConstraints, PinsGroundSpheresAndDragHold) {
       auto ref = make_cpu_pipeline({sc.m, sc.p, integ}, Precision::f64, true);
       const State r = advance(*ref, s0, kSteps);
       const Tolerance floor = rounding_floor(c, sc.p.dt);
-      for (Variant v : {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused}) {
+      for (Variant v : kVariants) {
         const std::string what = std::string(name(v)) + " " + std::string(info(integ).name) +
                                  (spring_drag ? " spring drag" : " hard drag");
-        auto gpu = cuda::make_pipeline({sc.m, sc.p, integ}, {v, {}, true});
+        auto gpu = cuda::make_pipeline({sc.m, sc.p, integ}, options(v));
         const State g = advance(*gpu, s0, kSteps);
         expect_constraints_hold(sc, s0, g, what);
         if (v != Variant::scatter) {

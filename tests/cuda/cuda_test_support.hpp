@@ -68,4 +68,6 @@ inline Tolerance rounding_floor(const State& s, float dt) {
 
 inline const char* name(cuda::Variant v) { return cuda::to_string(v); }
 
+inline cuda::Options options(cuda::Variant v, bool graphs = true, cuda::Tile tile = {}) { return {v, tile, graphs}; }
+
 }  // namespace deformlab::test
