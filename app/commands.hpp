@@ -31,6 +31,7 @@ struct ExperimentArgs {
   std::string file;  // a path, or the name of a built-in experiment (table1, quick, ...)
   std::optional<std::string> out;
   bool report_only = false;
+  std::optional<int> max_size;  // leave out sizes above this (a later run can add them)
 };
 
 // Runs `body`, turning an exception into one line on stderr and an exit code: 2 for

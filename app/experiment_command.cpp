@@ -17,6 +17,10 @@ int experiment_command(const ExperimentArgs& a) {
     x = load_experiment_by_name(a.file);
     sweep = parse_sweep(x.raw, a.file);
     if (!sweep) throw std::invalid_argument(a.file + ": has no \"sweep\" (run it with `deformlab run --experiment`)");
+    if (a.max_size) {
+      std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
+      if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
+    }
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << e.what() << "\n";
     return 2;

@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
   experiment->add_option("file", ex.file, "Experiment file, or a built-in name (table1, table2, table3, interop, tiles, swap, quick)")
       ->required();
   experiment->add_option("--out,-o", ex.out, "Results folder (default: runs/<experiment name>)");
+  experiment->add_option("--max-size", ex.max_size, "Leave out grid sizes above this for now (cells resume later)")
+      ->check(CLI::PositiveNumber);
   experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
 
   auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");

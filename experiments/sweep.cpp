@@ -105,25 +105,26 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
 }
 
 std::vector<Cell> cells(const Sweep& s) {
+  // Sizes outside pipelines, so that consecutive cells share one model.
   std::vector<Cell> out;
   for (const auto& integ : s.integrators)
-    for (const auto& pipe : s.pipelines) {
-      // A pipeline runs the option sets whose every name it reads; with none, it runs once.
-      const auto& accepted = pipelines().find(pipe)->options;
-      std::vector<PipelineOptions> sets;
-      for (const auto& o : s.option_sets)
-        if (std::all_of(o.begin(), o.end(), [&](const auto& kv) {
-              return std::find(accepted.begin(), accepted.end(), kv.first) != accepted.end();
-            }) && (!o.empty() || sets.empty()))
-          sets.push_back(o);
-      if (sets.empty()) sets.push_back({});
-      for (const auto& o : sets)
-        for (int n : s.sizes) out.push_back({n, pipe, integ, o});
-    }
+    for (int n : s.sizes)
+      for (const auto& pipe : s.pipelines) {
+        // A pipeline runs the option sets whose every name it reads; with none, it runs once.
+        const auto& accepted = pipelines().find(pipe)->options;
+        std::vector<PipelineOptions> sets;
+        for (const auto& o : s.option_sets)
+          if (std::all_of(o.begin(), o.end(), [&](const auto& kv) {
+                return std::find(accepted.begin(), accepted.end(), kv.first) != accepted.end();
+              }) && (!o.empty() || sets.empty()))
+            sets.push_back(o);
+        if (sets.empty()) sets.push_back({});
+        for (const auto& o : sets) out.push_back({n, pipe, integ, o});
+      }
   return out;
 }
 
-json run_cell(const Experiment& x, const Sweep& s, const Cell& c) {
+json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache) {
   using clock = std::chrono::steady_clock;
   json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
             {"options", c.options}};
@@ -151,7 +152,12 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c) {
     return na("does not fit: needs about " + std::to_string(need >> 20) + " MiB of host memory, " +
               std::to_string(have >> 20) + " MiB available");
   try {
-    const Model m = build_model(scene);
+    if (cache.size != c.size || !cache.model) {
+      cache.model.reset();  // free the old one before building the next
+      cache.model = std::make_unique<Model>(build_model(scene));
+      cache.size = c.size;
+    }
+    const Model& m = *cache.model;
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
     pipe->set_state(rest_state(m));
@@ -234,6 +240,7 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   prog.total = int(all.size());
   const auto start = clock::now();
   int ran = 0;
+  ModelCache cache;
   for (const auto& c : all) {
     const fs::path file = dir / "cells" / (c.id() + ".json");
     json r;
@@ -242,7 +249,7 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
       r = json::parse(in);
       ++prog.skipped;
     } else {
-      r = run_cell(x, s, c);
+      r = run_cell(x, s, c, cache);
       write_atomically(file, r.dump(2) + "\n");
       ++ran;
     }

@@ -5,6 +5,7 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -52,8 +53,14 @@ struct SweepOptions {
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
 
+// The last model built, reused by the next cell of the same size.
+struct ModelCache {
+  int size = 0;
+  std::unique_ptr<Model> model;
+};
+
 // One cell's result: {"status": "ok", "median_ms", ...} or {"status": "n/a", "reason"}.
-nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c);
+nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
 
 // Reads every cell result in `dir`/cells/.
 std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);

@@ -73,7 +73,8 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
 
 TEST_F(SweepTest, SlowCellsAreCutWithTheReason) {
   const Experiment x = tiny(R"({"sizes": [8], "pipelines": ["cpu"], "cell_limit_s": 1e-9})");
-  const json r = run_cell(x, *parse_sweep(x.raw, "tiny"), {8, "cpu", "midpoint", {}});
+  ModelCache cache;
+  const json r = run_cell(x, *parse_sweep(x.raw, "tiny"), {8, "cpu", "midpoint", {}}, cache);
   EXPECT_EQ(r["status"], "n/a");
   EXPECT_EQ(r["reason"].get<std::string>().rfind("cut: the first step took", 0), 0u) << r.dump();
 }
