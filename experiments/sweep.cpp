@@ -10,6 +10,10 @@
 #include "core/state.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
+#if DEFORMLAB_HAVE_GL
+#include "glsl_tf/context.hpp"
+#include "glsl_tf/render.hpp"
+#endif
 
 namespace deformlab {
 
@@ -83,7 +87,7 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
       if (!v.is_number() || !(v.get<double>() > 0)) bad(w + ".cell_limit_s", "expected a positive number");
       s.cell_limit_s = v.get<double>();
     } else if (k == "time") {
-      if (v != "update") bad(w + ".time", "expected \"update\" (rendered frames are not timed by sweeps yet)");
+      if (v != "update" && v != "frame") bad(w + ".time", "expected \"update\" or \"frame\" (update + render)");
       s.time = v.get<std::string>();
     } else if (k == "paper_table") {
       if (v != "table1" && v != "table2" && v != "table3" && v != "")
@@ -161,10 +165,31 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
     pipe->set_state(rest_state(m));
+    // "frame": every step is followed by a draw of the state at 1024 x 1024 (the paper's
+    // frame); pipelines outside GL hand their state over through a read-back.
+#if DEFORMLAB_HAVE_GL
+    std::unique_ptr<gl::Renderer> renderer;
+    if (s.time == "frame") {
+      if (auto why = gl::unavailable_reason(); !why.empty()) return na("frame timing needs OpenGL: " + why);
+      renderer = std::make_unique<gl::Renderer>(m);
+    }
+    auto step = [&] {
+      pipe->step();
+      if (renderer) renderer->draw(*pipe);
+    };
+    auto finish = [&] {
+      pipe->max_displacement();
+      if (renderer) renderer->take_draw_ms();  // waits for the draws
+    };
+#else
+    if (s.time == "frame") return na("frame timing needs a build with OpenGL");
+    auto step = [&] { pipe->step(); };
+    auto finish = [&] { pipe->max_displacement(); };
+#endif
     // One step first: it bounds the cell's time before committing to it.
     const auto t0 = clock::now();
-    pipe->step();
-    pipe->max_displacement();
+    step();
+    finish();
     const double first_s = std::chrono::duration<double>(clock::now() - t0).count();
     const double expect_s = first_s * (s.warmup + double(s.steps) * s.repetitions);
     if (expect_s > s.cell_limit_s) {
@@ -173,13 +198,13 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
          << " s, over its limit of " << s.cell_limit_s << " s";
       return na(os.str());
     }
-    for (int w = 1; w < s.warmup; ++w) pipe->step();
-    pipe->max_displacement();
+    for (int w = 1; w < s.warmup; ++w) step();
+    finish();
     std::vector<double> ms_per_step;
     for (int rep = 0; rep < s.repetitions; ++rep) {
       const auto b0 = clock::now();
-      for (int st = 0; st < s.steps; ++st) pipe->step();
-      pipe->max_displacement();  // waits for the device's last step
+      for (int st = 0; st < s.steps; ++st) step();
+      finish();  // waits for the device's last step (and draw)
       ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
     }
     const double d = pipe->max_displacement();
@@ -189,10 +214,12 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
     r["samples_ms"] = ms_per_step;
     r["stable"] = d == d;
     r["pipeline_timing"] = pipe->timing_method();
+    r["time"] = s.time;
     r["method"] = "host steady_clock around " + std::to_string(s.steps) +
-                  " steps closed by the pipeline's max-displacement reduction (which waits for the device), "
-                  "ms per step, median of " + std::to_string(s.repetitions) + " batches after " +
-                  std::to_string(s.warmup) + " warm-up steps";
+                  (s.time == "frame" ? " frames (a step and a 1024 x 1024 draw each)" : " steps") +
+                  " closed by the pipeline's max-displacement reduction (which waits for the device), "
+                  "ms per " + (s.time == "frame" ? "frame" : "step") + ", median of " +
+                  std::to_string(s.repetitions) + " batches after " + std::to_string(s.warmup) + " warm-up steps";
     return r;
   } catch (const std::invalid_argument& ex) {
     return na(ex.what());
