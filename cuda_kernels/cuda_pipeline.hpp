@@ -25,8 +25,8 @@ struct Tile {
 };
 // "WxH" -> Tile; throws std::invalid_argument on anything else.
 Tile parse_tile(const std::string& s);
-// The tile named by the environment variable DEFORMLAB_CUDA_TILE ("WxH"), else the default.
-Tile tile_from_env();
+// The tile named by the pipeline option "tile" ("WxH"), else the default.
+Tile tile_option(const PipelineOptions& o);
 
 struct Options {
   Variant variant = Variant::fused;

@@ -1,6 +1,5 @@
 #include "pipelines.hpp"
 
-#include <cstdlib>
 #include <stdexcept>
 
 #include "cuda_pipeline.hpp"
@@ -31,9 +30,9 @@ Tile parse_tile(const std::string& s) {
   }
 }
 
-Tile tile_from_env() {
-  const char* s = std::getenv("DEFORMLAB_CUDA_TILE");
-  return s && *s ? parse_tile(s) : Tile{};
+Tile tile_option(const PipelineOptions& o) {
+  const auto it = o.find("tile");
+  return it == o.end() ? Tile{} : parse_tile(it->second);
 }
 
 std::string unsupported(Integrator i) {
@@ -97,7 +96,7 @@ void add_cuda_pipelines(PipelineRegistry& r) {
   const Entry entries[] = {
       {"cuda-naive", Variant::naive, true, "CUDA, one thread per node gathering its springs from global memory"},
       {"cuda-tiled", Variant::tiled, true,
-       "CUDA, gather from a shared-memory tile with a 2-node halo (tile: DEFORMLAB_CUDA_TILE=WxH, default 16x8)"},
+       "CUDA, gather from a shared-memory tile with a 2-node halo"},
       {"cuda-scatter", Variant::scatter, false,
        "CUDA, one thread per spring, atomic scatter of +f/-f"},
       {"cuda-fused", Variant::fused, true,
@@ -105,11 +104,15 @@ void add_cuda_pipelines(PipelineRegistry& r) {
   };
   for (const Entry& e : entries) {
     const Variant v = e.v;
+    // "tile": the thread block shape WxH of the grid kernels (default 16x8).
+    std::vector<std::string> options;
+    if (v != Variant::scatter) options.push_back("tile");
     r.add({e.name, e.summary, e.deterministic, [] { return cuda::unavailable(); },
            [](Integrator i) { return cuda::unsupported(i); },
            [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> {
-             return cuda::make_pipeline(s, {v, cuda::tile_from_env(), true});
-           }});
+             return cuda::make_pipeline(s, {v, cuda::tile_option(s.options), true});
+           },
+           options});
   }
 }
 

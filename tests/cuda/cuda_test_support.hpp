@@ -18,24 +18,6 @@ namespace deformlab::test {
     if (const std::string why = cuda::unavailable(); !why.empty()) GTEST_SKIP() << why; \
   } while (0)
 
-// The grid kernels use one rest length per stencil offset: the model's value for the first
-// spring with that offset. The builders' rest lengths vary by a few ulps between springs of
-// one offset (they come from float rest positions), so the CPU pipeline run on this model is
-// what the grid kernels must reproduce operation for operation.
-inline Model uniform_rest(Model m) {
-  if (m.topology == Topology::general) return m;
-  const std::int64_t nxy = std::int64_t(m.nx) * m.ny;
-  std::vector<float> first(9 * 9 * 9, NAN);
-  for (int e = 0; e < m.spring_count(); ++e) {
-    const int a = m.spring_i[e], b = m.spring_j[e];
-    const int di = b % m.nx - a % m.nx, dj = int((b / m.nx) % m.ny - (a / m.nx) % m.ny), dk = int(b / nxy - a / nxy);
-    float& r = first[((dk + 4) * 9 + dj + 4) * 9 + di + 4];
-    if (std::isnan(r)) r = m.rest_length[e];
-    m.rest_length[e] = r;
-  }
-  return m;
-}
-
 // The same springs, seen as a general model: the kernels then gather over the CSR adjacency.
 inline Model as_general(Model m) {
   m.topology = Topology::general;

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# On a machine with an NVIDIA GPU (and the build folder beside the sources): the whole test
+# suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
+# and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
+# go into $1 (default gpu-check/); a short table is printed last.
+# Environment: BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
+# default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap").
+set -uo pipefail
+cd "$(dirname "$0")/.."
+build=${BUILD:-build/default}
+out=${1:-gpu-check}
+max=${MAX_SIZE:-4096}
+mkdir -p "$out/results"
+summary=()
+
+ctest --test-dir "$build" -j4 --output-on-failure >"$out/ctest.log" 2>&1
+summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
+grep -E "Label|^ *(unit|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
+
+cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
+if [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
+  for tool in memcheck racecheck synccheck initcheck; do
+    compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='*37x53*:*lattice7x5x6*:CudaConstraints*' \
+      >"$out/sanitizer-$tool.log" 2>&1
+    summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tail -1)")
+  done
+fi
+
+bench="$build/bench/deformlab-bench"
+"$bench" cuda --sizes 256 1024 2048 4096 --csv "$out/bench-cuda.csv" >"$out/bench-cuda.txt" 2>&1
+"$bench" gl --sizes 256 1024 2048 --csv "$out/bench-gl.csv" >"$out/bench-gl.txt" 2>&1
+
+app="$build/app/deformlab"
+"$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
+for x in ${EXPERIMENTS:-table2 table3 tiles interop swap}; do
+  "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
+  summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
+done
+
+printf '%s\n' "${summary[@]}"
