@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <algorithm>
+
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 #include <cmath>
@@ -22,7 +24,10 @@ class CpuPipeline final : public Pipeline {
 
  public:
   CpuPipeline(const PipelineSetup& s, bool parallel)
-      : m_(s.model), p_(s.params), sched_(make_schedule(s.integrator)), parallel_(parallel) {
+      : m_(s.model),
+        p_(s.params),
+        sched_(make_schedule(s.integrator)),
+        threads_(parallel ? std::clamp(m_.node_count() / kNodesPerThread, 1, omp_get_max_threads()) : 1) {
     const std::size_t n = m_.rest_position.size();
     slots_.resize(1 + sched_.stage_states);
     for (auto& sl : slots_) { sl.x.resize(n); sl.v.resize(n); }
@@ -81,7 +86,7 @@ class CpuPipeline final : public Pipeline {
   template <class F>
   void for_nodes(F&& f) {
     const int n = m_.node_count();
-#pragma omp parallel for schedule(static) if (parallel_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
     for (int i = 0; i < n; ++i) f(i);
   }
 
@@ -255,7 +260,8 @@ class CpuPipeline final : public Pipeline {
     double disp = 0.0;
     bool finite = true;
     const int n = m_.node_count();
-#pragma omp parallel for schedule(static) if (parallel_) reduction(max : disp) reduction(&& : finite)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1) reduction(max : disp) \
+    reduction(&& : finite)
     for (int i = 0; i < n; ++i) {
       V& x = next_.x[i];
       V& v = next_.v[i];
@@ -287,7 +293,10 @@ class CpuPipeline final : public Pipeline {
   const Model& m_;
   Params p_;
   Schedule sched_;
-  bool parallel_;
+  // OpenMP threads: at least kNodesPerThread nodes each, so that small models do not pay
+  // for more barriers than they have work (a thread more changes no result).
+  static constexpr int kNodesPerThread = 1024;
+  int threads_;
   std::vector<Slot> slots_;  // 0: current state, 1..: stage states
   std::vector<std::vector<V>> acc_;
   Slot next_;
