@@ -4,7 +4,7 @@
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
 # Environment: BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
-# default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap").
+# default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD:-build/default}
@@ -13,7 +13,7 @@ max=${MAX_SIZE:-4096}
 mkdir -p "$out/results"
 summary=()
 
-ctest --test-dir "$build" -j4 --output-on-failure >"$out/ctest.log" 2>&1
+ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
 summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
 grep -E "Label|^ *(unit|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
 
