@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The main job: set up, build, and run the paper's drag experiment on the best pipeline
-# this machine has. Extra arguments go to `deformlab run` (e.g. --out DIR).
+# The main job: set up, build, run the paper's drag experiment on the best pipeline this
+# machine has (runs/paper-drag/), then the quick sweep of every pipeline here with its
+# report (runs/quick/report.md). Extra arguments go to `deformlab run`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh default
-exec build/default/app/deformlab run --out runs/paper-drag "$@"
+build/default/app/deformlab run --out runs/paper-drag "$@"
+build/default/app/deformlab experiment quick --out runs/quick
