@@ -1,5 +1,6 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
-// and the device reductions (displacement, energy).
+// and the device reductions (displacement, energy); and its force pass on its own, the force
+// stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels.
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -13,6 +14,7 @@
 
 #include "check.cuh"
 #include "cuda_pipeline.hpp"
+#include "force_stage.hpp"
 #include "kernels.cuh"
 
 namespace deformlab::cuda {
@@ -81,6 +83,155 @@ Stencil make_stencil(const Model& m) {
   return st;
 }
 
+// Throws std::invalid_argument when the tile is not a block shape or the grid exceeds the
+// launch limits with it.
+void check_tile(const Model& m, const Tile& t) {
+  if (t.x < 1 || t.y < 1 || t.x * t.y > 1024)
+    throw std::invalid_argument("CUDA tile " + std::to_string(t.x) + "x" + std::to_string(t.y) +
+                                " is not a valid block shape (1..1024 threads)");
+  if (m.topology == Topology::general) return;
+  if ((m.ny + t.y - 1) / t.y > 65535 || m.nz > 65535)
+    throw std::invalid_argument("grid of " + std::to_string(m.ny) + " rows / " + std::to_string(m.nz) +
+                                " layers exceeds the CUDA launch limits for tile height " + std::to_string(t.y));
+}
+
+// The model and scene on the device as the kernels see them (scene, stencil or adjacency,
+// springs, spheres) and the force pass of the gather and scatter variants: the base of the
+// CUDA pipeline and, on its own, the force stage of the hybrid pipelines.
+class ForceKernels {
+ public:
+  ForceKernels(const Model& m, const Params& p, const Options& o) : model_(m), o_(o) {
+    grid_ = m.topology != Topology::general;
+    scene_.n = m.node_count();
+    scene_.nx = m.nx; scene_.ny = m.ny; scene_.nz = std::max(1, m.nz);
+    for (int k = 0; k < kSpringKinds; ++k) { scene_.k[k] = m.stiffness[k]; scene_.kd[k] = m.damping[k]; }
+    damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
+    scene_.gravity = p.gravity; scene_.wind = p.wind;
+    scene_.c = p.damping; scene_.dt = p.dt;
+    if (p.drag.active()) {
+      scene_.drag_node = p.drag.node;
+      scene_.drag_hard = !p.drag.as_spring;
+      scene_.drag_k = p.drag.stiffness;
+    }
+    scene_.has_ground = p.ground.has_value();
+    scene_.ground = p.ground.value_or(0.f);
+    if (!p.spheres.empty()) {
+      std::vector<float4> sp;
+      for (const auto& s : p.spheres) sp.push_back(make_float4(s.center.x, s.center.y, s.center.z, s.radius));
+      upload(spheres_, sp, "uploading the sphere colliders");
+      scene_.sphere_count = int(sp.size());
+      scene_.spheres = spheres_.get();
+    }
+
+    if (grid_) {
+      stencil_ = make_stencil(m);
+      const int full = scene_.nz > 1 ? dev::kMaxStencil : 12;
+      canonical_ = stencil_.count == full;
+      for (int e = 0; e < stencil_.count && canonical_; ++e) {
+        const dev::Offset o = dev::canonical_offset(full, e);
+        canonical_ = o.di == stencil_.di[e] && o.dj == stencil_.dj[e] && o.dk == stencil_.dk[e];
+      }
+    } else if (o_.variant != Variant::scatter) {
+      std::vector<Link> links(m.adj_node.size());
+      for (std::size_t e = 0; e < links.size(); ++e) {
+        const int sp = m.adj_spring[e];
+        links[e] = {m.adj_node[e], int(m.kind[sp]), m.rest_length[sp], 0};
+      }
+      upload(offset_, m.adj_offset, "uploading the adjacency offsets");
+      upload(links_, links, "uploading the adjacency");
+    }
+    if (o_.variant == Variant::scatter) upload_springs();
+  }
+
+  // acc = a(x, v) for every node, queued on `stream`.
+  void forces(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
+    if (o_.variant == Variant::scatter) {
+      check(cudaMemsetAsync(acc, 0, std::size_t(scene_.n) * sizeof(float4), stream), "clearing the force sums");
+      const std::int64_t s = std::int64_t(springs_.size());
+      if (s > 0) {
+        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream>>>(scene_, springs_.get(), s, x, v, acc);
+        check_launch("launching the scatter kernel");
+      }
+      dev::scatter_finish<<<blocks_for(scene_.n), kBlock, 0, stream>>>(scene_, x, v, acc, target);
+      check_launch("launching the scatter finishing kernel");
+      return;
+    }
+    if (!grid_) {
+      dev::force_csr<<<blocks_for(scene_.n), kBlock, 0, stream>>>(scene_, offset_.get(), links_.get(), x, v, acc, target);
+      check_launch("launching the CSR gather force kernel");
+      return;
+    }
+    const bool tiled = o_.variant == Variant::tiled;
+    with_grid_flags([&](auto n, auto damped, auto canonical) {
+      if (tiled) launch_force_grid<n(), damped(), canonical(), true>(x, v, acc, target, stream);
+      else launch_force_grid<n(), damped(), canonical(), false>(x, v, acc, target, stream);
+    });
+  }
+
+ protected:
+  // Synchronous: done before any work is queued (or, for the springs, before they are read).
+  template <class T>
+  void upload(Buffer<T>& b, const std::vector<T>& h, const char* what) {
+    b.allocate(h.size(), what);
+    if (!h.empty()) check(cudaMemcpy(b.get(), h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice), what);
+  }
+  void upload_springs() {
+    const Model& m = model_;
+    std::vector<Spring> sp(m.spring_count());
+    for (int e = 0; e < m.spring_count(); ++e) sp[e] = {m.spring_i[e], m.spring_j[e], int(m.kind[e]), m.rest_length[e]};
+    require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
+    upload(springs_, sp, "uploading the spring list");
+  }
+  dim3 grid_blocks() const {
+    return dim3(unsigned((scene_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((scene_.ny + o_.tile.y - 1) / o_.tile.y),
+                unsigned(scene_.nz));
+  }
+  dim3 grid_threads() const { return dim3(unsigned(o_.tile.x), unsigned(o_.tile.y), 1); }
+
+  // Calls f(N, Damped, Canonical) with the grid kernels' compile-time flags for this model.
+  template <class F>
+  void with_grid_flags(F&& f) const {
+    using std::bool_constant;
+    using std::integral_constant;
+    auto canon = [&](auto n, auto damped) {
+      if (canonical_) f(n, damped, bool_constant<true>{});
+      else f(n, damped, bool_constant<false>{});
+    };
+    auto damp = [&](auto n) {
+      if (damped_) canon(n, bool_constant<true>{});
+      else canon(n, bool_constant<false>{});
+    };
+    if (scene_.nz > 1) damp(integral_constant<int, dev::kMaxStencil>{});
+    else damp(integral_constant<int, 12>{});
+  }
+
+  template <int N, bool Damped, bool Canonical, bool Tiled>
+  void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
+    const auto kernel = dev::force_grid<N, Damped, Canonical, Tiled>;
+    std::size_t shared = 0;
+    if (Tiled) {
+      const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
+                                (N > 12 ? 2 * dev::kHalo + 1 : 1);
+      shared = cells * sizeof(float4) * (Damped ? 2 : 1);
+      if (shared > 48 * 1024)
+        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
+              "raising the tiled kernel's shared-memory limit");
+    }
+    kernel<<<grid_blocks(), grid_threads(), shared, stream>>>(scene_, stencil_, x, v, acc, target);
+    check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
+  }
+
+  const Model& model_;
+  Options o_;
+  bool grid_ = false, damped_ = false, canonical_ = false;
+  Scene scene_;
+  Stencil stencil_{};
+  Buffer<float4> spheres_;
+  Buffer<int> offset_;
+  Buffer<Link> links_;
+  Buffer<Spring> springs_;
+};
+
 struct DispOp {  // |x_new - x_old|, +inf where anything is not finite
   const float4* x;
   const float4* x_old;
@@ -126,46 +277,17 @@ struct SpringEnergyOp {
   }
 };
 
-class Impl final : public CudaPipeline {
+class Impl final : public CudaPipeline, private ForceKernels {
  public:
   Impl(const PipelineSetup& su, const Options& o)
-      : model_(su.model), p_(su.params), sched_(make_schedule(su.integrator)), o_(o) {
-    if (const std::string why = unsupported(su.integrator); !why.empty()) throw std::invalid_argument(why);
-    if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
-    validate(p_, model_.node_count());
+      : ForceKernels(checked(su, o), su.params, o), p_(su.params), sched_(make_schedule(su.integrator)) {
     const Model& m = model_;
     n_ = m.node_count();
-    grid_ = m.topology != Topology::general;
-    if (o_.variant == Variant::tiled || grid_) check_tile(m);
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
-    require_device_memory(bytes_needed(m, su.integrator, o_),
-                          std::string("the cuda-") + to_string(o_.variant) + " pipeline for " + std::to_string(n_) +
-                              " nodes (" + std::string(info(su.integrator).name) + ")");
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
     check(cudaEventCreate(&ev_[0]), "creating a timing event");
     check(cudaEventCreate(&ev_[1]), "creating a timing event");
-
-    scene_.n = n_;
-    scene_.nx = m.nx; scene_.ny = m.ny; scene_.nz = std::max(1, m.nz);
-    for (int k = 0; k < kSpringKinds; ++k) { scene_.k[k] = m.stiffness[k]; scene_.kd[k] = m.damping[k]; }
-    damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
-    scene_.gravity = p_.gravity; scene_.wind = p_.wind;
-    scene_.c = p_.damping; scene_.dt = p_.dt;
-    if (p_.drag.active()) {
-      scene_.drag_node = p_.drag.node;
-      scene_.drag_hard = !p_.drag.as_spring;
-      scene_.drag_k = p_.drag.stiffness;
-    }
-    scene_.has_ground = p_.ground.has_value();
-    scene_.ground = p_.ground.value_or(0.f);
-    if (!p_.spheres.empty()) {
-      std::vector<float4> sp;
-      for (const auto& s : p_.spheres) sp.push_back(make_float4(s.center.x, s.center.y, s.center.z, s.radius));
-      upload(spheres_, sp, "uploading the sphere colliders");
-      scene_.sphere_count = int(sp.size());
-      scene_.spheres = spheres_.get();
-    }
 
     for (auto& b : x_) b.allocate(n_, "allocating positions");
     for (auto& b : v_) b.allocate(n_, "allocating velocities");
@@ -176,24 +298,6 @@ class Impl final : public CudaPipeline {
     if (!fused_)
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
 
-    if (grid_) {
-      stencil_ = make_stencil(m);
-      const int full = scene_.nz > 1 ? dev::kMaxStencil : 12;
-      canonical_ = stencil_.count == full;
-      for (int e = 0; e < stencil_.count && canonical_; ++e) {
-        const dev::Offset o = dev::canonical_offset(full, e);
-        canonical_ = o.di == stencil_.di[e] && o.dj == stencil_.dj[e] && o.dk == stencil_.dk[e];
-      }
-    } else if (o_.variant != Variant::scatter) {
-      std::vector<Link> links(m.adj_node.size());
-      for (std::size_t e = 0; e < links.size(); ++e) {
-        const int sp = m.adj_spring[e];
-        links[e] = {m.adj_node[e], int(m.kind[sp]), m.rest_length[sp], 0};
-      }
-      upload(offset_, m.adj_offset, "uploading the adjacency offsets");
-      upload(links_, links, "uploading the adjacency");
-    }
-    if (o_.variant == Variant::scatter) upload_springs();
     set_state(rest_state(m));
   }
 
@@ -293,23 +397,11 @@ class Impl final : public CudaPipeline {
   }
 
  private:
-  template <class T>
-  void upload(Buffer<T>& b, const std::vector<T>& h, const char* what) {
-    b.allocate(h.size(), what);
-    copy_in(b.get(), h.data(), h.size() * sizeof(T), what);
-  }
   // Uploads go through the pipeline's stream, ordered after the steps already queued.
   void copy_in(void* dst, const void* src, std::size_t bytes, const char* what) {
     if (bytes == 0) return;
     check(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream_), what);
     check(cudaStreamSynchronize(stream_), what);
-  }
-  void upload_springs() {
-    const Model& m = model_;
-    std::vector<Spring> sp(m.spring_count());
-    for (int e = 0; e < m.spring_count(); ++e) sp[e] = {m.spring_i[e], m.spring_j[e], int(m.kind[e]), m.rest_length[e]};
-    require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
-    upload(springs_, sp, "uploading the spring list");
   }
   void upload_positions(Buffer<float4>& b, const std::vector<Vec3f>& x) {
     std::vector<float4> h(n_);
@@ -329,17 +421,6 @@ class Impl final : public CudaPipeline {
     std::vector<Vec3f> out(n_);
     for (int i = 0; i < n_; ++i) out[i] = {h[i].x, h[i].y, h[i].z};
     return out;
-  }
-
-  void check_tile(const Model& m) {
-    const Tile t = o_.tile;
-    if (t.x < 1 || t.y < 1 || t.x * t.y > 1024)
-      throw std::invalid_argument("CUDA tile " + std::to_string(t.x) + "x" + std::to_string(t.y) +
-                                  " is not a valid block shape (1..1024 threads)");
-    if (!grid_) return;
-    if ((m.ny + t.y - 1) / t.y > 65535 || m.nz > 65535)
-      throw std::invalid_argument("grid of " + std::to_string(m.ny) + " rows / " + std::to_string(m.nz) +
-                                  " layers exceeds the CUDA launch limits for tile height " + std::to_string(t.y));
   }
 
   // The drag handle's targets do not change from step to step (none, or past its path).
@@ -366,12 +447,6 @@ class Impl final : public CudaPipeline {
     check(e, "instantiating the step graph");
   }
 
-  dim3 grid_blocks() const {
-    return dim3(unsigned((scene_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((scene_.ny + o_.tile.y - 1) / o_.tile.y),
-                unsigned(scene_.nz));
-  }
-  dim3 grid_threads() const { return dim3(unsigned(o_.tile.x), unsigned(o_.tile.y), 1); }
-
   // Slot 0 is the current state, 1.. the stage states.
   const float4* slot_x(int k) const { return k == 0 ? x_[cur_].get() : sx_[k - 1].get(); }
   const float4* slot_v(int k) const { return k == 0 ? v_[cur_].get() : sv_[k - 1].get(); }
@@ -389,63 +464,21 @@ class Impl final : public CudaPipeline {
     }
   }
 
-  // Calls f(N, Damped, Canonical) with the grid kernels' compile-time flags for this model.
-  template <class F>
-  void with_grid_flags(F&& f) const {
-    using std::bool_constant;
-    using std::integral_constant;
-    auto canon = [&](auto n, auto damped) {
-      if (canonical_) f(n, damped, bool_constant<true>{});
-      else f(n, damped, bool_constant<false>{});
-    };
-    auto damp = [&](auto n) {
-      if (damped_) canon(n, bool_constant<true>{});
-      else canon(n, bool_constant<false>{});
-    };
-    if (scene_.nz > 1) damp(integral_constant<int, dev::kMaxStencil>{});
-    else damp(integral_constant<int, 12>{});
-  }
-
-  template <int N, bool Damped, bool Canonical, bool Tiled>
-  void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target) {
-    const auto kernel = dev::force_grid<N, Damped, Canonical, Tiled>;
-    std::size_t shared = 0;
-    if (Tiled) {
-      const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
-                                (N > 12 ? 2 * dev::kHalo + 1 : 1);
-      shared = cells * sizeof(float4) * (Damped ? 2 : 1);
-      if (shared > 48 * 1024)
-        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
-              "raising the tiled kernel's shared-memory limit");
-    }
-    kernel<<<grid_blocks(), grid_threads(), shared, stream_>>>(scene_, stencil_, x, v, acc, target);
-    check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
+  // The checks in the order their errors are reported, before anything is allocated.
+  static const Model& checked(const PipelineSetup& su, const Options& o) {
+    if (const std::string why = unsupported(su.integrator); !why.empty()) throw std::invalid_argument(why);
+    if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
+    validate(su.params, su.model.node_count());
+    if (o.variant == Variant::tiled || su.model.topology != Topology::general) check_tile(su.model, o.tile);
+    require_device_memory(bytes_needed(su.model, su.integrator, o),
+                          std::string("the cuda-") + to_string(o.variant) + " pipeline for " +
+                              std::to_string(su.model.node_count()) + " nodes (" +
+                              std::string(info(su.integrator).name) + ")");
+    return su.model;
   }
 
   void force_pass(int src, int slot, Vec3f target) {
-    const float4 *x = slot_x(src), *v = slot_v(src);
-    float4* acc = acc_[slot].get();
-    if (o_.variant == Variant::scatter) {
-      check(cudaMemsetAsync(acc, 0, std::size_t(n_) * sizeof(float4), stream_), "clearing the force sums");
-      const std::int64_t s = std::int64_t(springs_.size());
-      if (s > 0) {
-        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream_>>>(scene_, springs_.get(), s, x, v, acc);
-        check_launch("launching the scatter kernel");
-      }
-      dev::scatter_finish<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x, v, acc, target);
-      check_launch("launching the scatter finishing kernel");
-      return;
-    }
-    if (!grid_) {
-      dev::force_csr<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, offset_.get(), links_.get(), x, v, acc, target);
-      check_launch("launching the CSR gather force kernel");
-      return;
-    }
-    const bool tiled = o_.variant == Variant::tiled;
-    with_grid_flags([&](auto n, auto damped, auto canonical) {
-      if (tiled) launch_force_grid<n(), damped(), canonical(), true>(x, v, acc, target);
-      else launch_force_grid<n(), damped(), canonical(), false>(x, v, acc, target);
-    });
+    forces(slot_x(src), slot_v(src), acc_[slot].get(), target, stream_);
   }
 
   template <Integrator I>
@@ -519,22 +552,14 @@ class Impl final : public CudaPipeline {
     }
   }
 
-  const Model& model_;
   Params p_;
   Schedule sched_;
-  Options o_;
   int n_ = 0;
-  bool grid_ = false, fused_ = false, damped_ = false, canonical_ = false;
-  Scene scene_;
-  Stencil stencil_{};
+  bool fused_ = false;
 
   Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
-  Buffer<float4> spheres_;
-  Buffer<int> offset_;
-  Buffer<Link> links_;
-  Buffer<Spring> springs_;
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t ev_[2] = {};
@@ -544,10 +569,27 @@ class Impl final : public CudaPipeline {
   double t_ = 0.0;
 };
 
+// The force pass alone, on the current device (the hybrid pipelines' CUDA stage).
+class Stage final : public ForceStage, private ForceKernels {
+ public:
+  Stage(const Model& m, const Params& p, const Options& o) : ForceKernels(m, p, o) {}
+  void run(const float4* x, const float4* v, float4* acc, Vec3f drag_target, CUstream_st* stream) override {
+    forces(x, v, acc, drag_target, stream);
+  }
+};
+
 }  // namespace
 
 std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
   return std::make_unique<Impl>(s, o);
+}
+
+std::unique_ptr<ForceStage> make_force_stage(const Model& m, const Params& p, Variant v, Tile tile) {
+  if (v == Variant::fused) throw std::invalid_argument("cuda-fused is a whole step, not a force pass");
+  if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
+  validate(p, m.node_count());
+  if (v == Variant::tiled || m.topology != Topology::general) check_tile(m, tile);
+  return std::make_unique<Stage>(m, p, Options{v, tile, false});
 }
 
 }  // namespace deformlab::cuda
