@@ -7,10 +7,13 @@ namespace {
 
 class ComputePipeline final : public GlPipeline {
  public:
-  explicit ComputePipeline(const PipelineSetup& s) : GlPipeline(s, "glsl-compute") {
+  ComputePipeline(const PipelineSetup& s, ExternalForces* forces)
+      : GlPipeline(s, forces ? "hybrid-compute" : "glsl-compute", forces) {
     GLint blocks = 0;
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
-    if (blocks < 11) throw std::invalid_argument("glsl-compute needs 11 storage buffers per compute shader");
+    const int need = forces ? 12 : 11;
+    if (blocks < need)
+      throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
     init();
   }
 
@@ -21,8 +24,9 @@ class ComputePipeline final : public GlPipeline {
 
   void run_pass(GLuint program, const PassIO& io) override {
     const NodeBuffer* in[7] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v, io.acc_x, io.acc_v};
-    for (int k = 0; k < 7; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->buf.id());
-    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7 + k, io.out[k]->buf.id());
+    for (int k = 0; k < 7; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->id());
+    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7 + k, io.out[k]->id());
+    if (io.forces_acc) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, io.forces_acc->id());
     glUseProgram(program);
     glDispatchCompute(GLuint((n_ + 255) / 256), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -33,7 +37,11 @@ class ComputePipeline final : public GlPipeline {
 }  // namespace
 
 std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s) {
-  return std::make_unique<ComputePipeline>(s);
+  return std::make_unique<ComputePipeline>(s, nullptr);
+}
+
+std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, ExternalForces* forces) {
+  return std::make_unique<ComputePipeline>(s, forces);
 }
 
 }  // namespace deformlab::gl

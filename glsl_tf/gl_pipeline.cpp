@@ -69,8 +69,8 @@ std::vector<StencilOffset> grid_stencil(const Model& m) {
   return st;
 }
 
-GlPipeline::GlPipeline(const PipelineSetup& s, std::string name)
-    : name_(std::move(name)), m_(s.model), p_(s.params), integrator_(s.integrator) {
+GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces* forces)
+    : name_(std::move(name)), forces_(forces), m_(s.model), p_(s.params), integrator_(s.integrator) {
   context();
   n_ = m_.node_count();
   if (n_ < 1) throw std::invalid_argument(name_ + ": the model has no nodes");
@@ -85,23 +85,32 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name)
   timer_ = std::make_unique<Timer>();
 
   const std::size_t bytes = std::size_t(n_) * 16;
-  auto node_buffer = [&] {
+  // The states forces are evaluated at (and the accelerations) belong to the external
+  // force stage when there is one.
+  auto node_buffer = [&](bool forces_read) {
     NodeBuffer b;
-    b.buf = make_buffer(bytes);
-    b.tex = make_texture_buffer(b.buf.id(), GL_RGBA32F);
+    if (forces_ && forces_read)
+      b.external = forces_->node_buffer(bytes, NodeRole::state);
+    else
+      b.buf = make_buffer(bytes);
+    b.tex = make_texture_buffer(b.id(), GL_RGBA32F);
     return b;
   };
   const Schedule sched = make_schedule(integrator_);
   for (int k = 0; k < 2; ++k) {
-    x_[k] = node_buffer();
-    v_[k] = node_buffer();
-    if (integrator_ == Integrator::verlet) xp_[k] = node_buffer();
+    x_[k] = node_buffer(true);
+    v_[k] = node_buffer(true);
+    if (integrator_ == Integrator::verlet) xp_[k] = node_buffer(false);
     if (!sched.single_pass()) {
-      sx_[k] = node_buffer();
-      sv_[k] = node_buffer();
-      ax_[k] = node_buffer();
-      av_[k] = node_buffer();
+      sx_[k] = node_buffer(true);
+      sv_[k] = node_buffer(true);
+      ax_[k] = node_buffer(false);
+      av_[k] = node_buffer(false);
     }
+  }
+  if (forces_) {
+    forces_acc_.external = forces_->node_buffer(bytes, NodeRole::accelerations);
+    forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
   }
 
   SimParams u{};
@@ -209,7 +218,8 @@ void GlPipeline::plan(const Schedule& s) {
 void GlPipeline::init() {
   static const char* kind_define[] = {"PASS_EXPLICIT_EULER", "PASS_SEMI_IMPLICIT_EULER", "PASS_VERLET",
                                       "PASS_STAGE", "PASS_COMBINE"};
-  const std::string topo = stencil_.empty() ? "#define TOPOLOGY_GENERAL 1\n" : "#define TOPOLOGY_GRID 1\n";
+  const std::string topo = std::string(stencil_.empty() ? "#define TOPOLOGY_GENERAL 1\n" : "#define TOPOLOGY_GRID 1\n") +
+                           (forces_ ? "#define EXTERNAL_FORCES 1\n" : "");
   for (const GpuPass& g : passes_) {
     PassProgram& pp = programs_[int(g.kind)];
     if (pp.prog) continue;
@@ -224,6 +234,8 @@ void GlPipeline::init() {
   }
   reduce_ = gl::make_program({{GL_COMPUTE_SHADER, "reduce.comp"}});
   reduce_n_ = uniform(reduce_.id(), "u_n");
+  copy_ = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
+  copy_n_ = uniform(copy_.id(), "u_n");
   check(name_ + " setup");
   set_state(rest_state(m_));
 }
@@ -251,14 +263,21 @@ void GlPipeline::set_state(const State& s) {
       data[4 * i + 2] = src[i].z;
       data[4 * i + 3] = inv_mass ? m_.inv_mass[i] : 0.f;
     }
-    glBindBuffer(GL_ARRAY_BUFFER, b.buf.id());
-    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(data.size() * 4), data.data());
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    // Through a shader copy (see shaders/copy.comp): buffers of the external force stage
+    // may be memory imported from another API, with immutable storage.
+    const Buffer staging = make_buffer(data.size() * 4, data.data());
+    glUseProgram(copy_.id());
+    glUniform1i(copy_n_, n_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, staging.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, b.id());
+    glDispatchCompute(GLuint(std::min(65535, (n_ + 255) / 256)), 1, 1);
+    glUseProgram(0);
   };
   upload(x_[cur_], s.x, true);
   upload(v_[cur_], s.v, false);
   has_prev_ = !s.x_prev.empty() && integrator_ == Integrator::verlet;
   if (has_prev_) upload(xp_[cur_], s.x_prev, true);
+  glMemoryBarrier(GL_ALL_BARRIER_BITS);
   t_ = s.t;
   stepped_ = false;
   on_set_state();
@@ -270,7 +289,7 @@ State GlPipeline::state() {
   const std::size_t n = std::size_t(n_);
   std::vector<float> data(4 * n);
   auto download = [&](const NodeBuffer& b, std::vector<Vec3f>& out) {
-    read_buffer(b.buf.id(), data.size() * 4, data.data());
+    read_buffer(b.id(), data.size() * 4, data.data());
     out.resize(n);
     for (std::size_t i = 0; i < n; ++i) out[i] = {data[4 * i], data[4 * i + 1], data[4 * i + 2]};
   };
@@ -288,7 +307,8 @@ void GlPipeline::step() {
   const int c = cur_, d = 1 - cur_;
   const double dt = p_.dt;
   const Vec3f next = p_.drag.active() ? p_.drag.target(t_ + dt) : Vec3f{};
-  timer_->begin();
+  // With an external force stage, it times the passes (GL timer spans may not nest).
+  if (!forces_) timer_->begin();
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
   bind_model_textures();
   for (const GpuPass& g : passes_) {
@@ -320,10 +340,15 @@ void GlPipeline::step() {
       io.out = {&x_[d], &v_[d], &xp_[d], nullptr};
       io.outputs = g.kind == PassKind::verlet ? 3 : 2;
     }
+    if (forces_) {
+      forces_->forces(io.src_x->id(), io.src_v->id(), forces_acc_.id(), t_ + g.time_fraction * dt);
+      io.forces_acc = &forces_acc_;
+    }
     run_pass(id, io);
+    if (forces_) forces_->update_issued();
     check_debug(name_ + " pass " + std::to_string(&g - passes_.data()));
   }
-  timer_->end();
+  if (!forces_) timer_->end();
   check(name_ + " step");
   cur_ = d;
   t_ += dt;
@@ -339,7 +364,7 @@ double GlPipeline::max_displacement() {
   glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, 4, &zero);
   glUseProgram(reduce_.id());
   glUniform1i(reduce_n_, n_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, v_[cur_].buf.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, v_[cur_].id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
   glDispatchCompute(GLuint(std::min(1024, (n_ + 255) / 256)), 1, 1);
   std::uint32_t bits = 0;
@@ -354,7 +379,7 @@ double GlPipeline::max_displacement() {
 GLuint GlPipeline::position_buffer() {
   context();
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  return x_[cur_].buf.id();
+  return x_[cur_].id();
 }
 
 }  // namespace deformlab::gl

@@ -21,6 +21,22 @@ struct StencilOffset {
 };
 std::vector<StencilOffset> grid_stencil(const Model& m);
 
+// Forces from outside the GL layer (the hybrid pipelines): another stage writes each node's
+// acceleration into a GL buffer that the update passes read instead of evaluating forces.
+enum class NodeRole { state, accelerations };
+class ExternalForces {
+ public:
+  virtual ~ExternalForces() = default;
+  // A GL buffer of `bytes` that the force stage owns: a state the forces are evaluated at
+  // (the stage reads it) or the accelerations (the stage writes them).
+  virtual GLuint node_buffer(std::size_t bytes, NodeRole role) = 0;
+  // Before each update pass: acc = a(x, v) at time t. GL commands issued before this call
+  // wrote x and v; those issued after it read acc.
+  virtual void forces(GLuint x, GLuint v, GLuint acc, double t) = 0;
+  // After each update pass was issued.
+  virtual void update_issued() {}
+};
+
 class GlPipeline : public Pipeline {
  public:
   ~GlPipeline() override;
@@ -40,8 +56,10 @@ class GlPipeline : public Pipeline {
  protected:
   enum class PassKind { explicit_euler, semi_implicit_euler, verlet, stage, combine };
   struct NodeBuffer {
-    Buffer buf;
-    Texture tex;  // texture buffer view (RGBA32F)
+    Buffer buf;           // owned here, or
+    GLuint external = 0;  // owned by the external force stage
+    Texture tex;          // texture buffer view (RGBA32F)
+    GLuint id() const { return external ? external : buf.id(); }
   };
   // What one pass reads and writes. s0: the current state (and Verlet's previous
   // positions); src: the state the forces are evaluated at; acc: the running sums.
@@ -50,9 +68,11 @@ class GlPipeline : public Pipeline {
     const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v, *acc_x, *acc_v;
     std::array<const NodeBuffer*, 4> out;
     int outputs;
+    const NodeBuffer* forces_acc;  // accelerations from the external force stage, else null
   };
 
-  GlPipeline(const PipelineSetup& s, std::string name);
+  // With `forces`, the passes read accelerations from it instead of evaluating forces.
+  GlPipeline(const PipelineSetup& s, std::string name, ExternalForces* forces = nullptr);
   // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
   void init();
   // `defines` selects the pass kind and the neighbour mode (see shaders/sim.glsl).
@@ -64,6 +84,8 @@ class GlPipeline : public Pipeline {
 
   int n_ = 0;
   const std::string name_;
+  ExternalForces* const forces_;
+  NodeBuffer forces_acc_;  // what the external force stage writes
   std::array<NodeBuffer, 2> x_, v_, xp_;      // state sets, ping-pong (xp_: Verlet)
   std::array<NodeBuffer, 2> sx_, sv_, ax_, av_;  // stage states and running sums, ping-pong
 
@@ -90,8 +112,8 @@ class GlPipeline : public Pipeline {
   std::array<PassProgram, 5> programs_;
   Buffer params_ubo_, adj_offset_, adj_entry_, adj_rest_, result_;
   Texture adj_offset_tex_, adj_entry_tex_, adj_rest_tex_;
-  Program reduce_;
-  GLint reduce_n_ = -1;
+  Program reduce_, copy_;
+  GLint reduce_n_ = -1, copy_n_ = -1;
   std::unique_ptr<Timer> timer_;
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;

@@ -3,10 +3,15 @@
 #include <memory>
 
 #include "core/pipeline.hpp"
+#include "gl_pipeline.hpp"
 
 namespace deformlab::gl {
 
 std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s);
 std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s);
+// The same passes reading each node's acceleration from `forces` instead of evaluating
+// forces (the update passes of the hybrid pipelines).
+std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, ExternalForces* forces);
+std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, ExternalForces* forces);
 
 }  // namespace deformlab::gl

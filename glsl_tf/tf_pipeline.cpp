@@ -11,7 +11,8 @@ namespace {
 
 class TfPipeline final : public GlPipeline {
  public:
-  explicit TfPipeline(const PipelineSetup& s) : GlPipeline(s, "glsl-tf") {
+  TfPipeline(const PipelineSetup& s, ExternalForces* forces)
+      : GlPipeline(s, forces ? "hybrid" : "glsl-tf", forces) {
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
     if (separate < 4) throw std::invalid_argument("glsl-tf needs 4 separate transform feedback buffers");
@@ -20,7 +21,7 @@ class TfPipeline final : public GlPipeline {
       glGenVertexArrays(1, &id);
       vao_[k] = VertexArray(id);
       glBindVertexArray(id);
-      const GLuint attrs[3] = {x_[k].buf.id(), v_[k].buf.id(), xp_[k].buf.id()};
+      const GLuint attrs[3] = {x_[k].id(), v_[k].id(), xp_[k].id()};
       for (GLuint a = 0; a < 3; ++a) {
         if (!attrs[a]) continue;
         glBindBuffer(GL_ARRAY_BUFFER, attrs[a]);
@@ -43,7 +44,7 @@ class TfPipeline final : public GlPipeline {
   // One transform feedback object per set of output buffers, made on first use.
   GLuint feedback(const PassIO& io) {
     std::array<GLuint, 4> key{};
-    for (int k = 0; k < io.outputs; ++k) key[k] = io.out[k]->buf.id();
+    for (int k = 0; k < io.outputs; ++k) key[k] = io.out[k]->id();
     auto& tfo = tfos_[key];
     if (!tfo) {
       GLuint id = 0;
@@ -62,6 +63,10 @@ class TfPipeline final : public GlPipeline {
     for (int k = 0; k < 4; ++k) {
       glActiveTexture(GL_TEXTURE0 + k);
       glBindTexture(GL_TEXTURE_BUFFER, tex[k]);
+    }
+    if (io.forces_acc) {
+      glActiveTexture(GL_TEXTURE7);
+      glBindTexture(GL_TEXTURE_BUFFER, io.forces_acc->tex.id());
     }
     glActiveTexture(GL_TEXTURE0);
     glUseProgram(program);
@@ -92,6 +97,10 @@ class TfPipeline final : public GlPipeline {
 
 }  // namespace
 
-std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s) { return std::make_unique<TfPipeline>(s); }
+std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s) { return std::make_unique<TfPipeline>(s, nullptr); }
+
+std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, ExternalForces* forces) {
+  return std::make_unique<TfPipeline>(s, forces);
+}
 
 }  // namespace deformlab::gl

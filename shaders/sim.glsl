@@ -4,6 +4,8 @@
 //   vec4 src_x(int j), src_v(int j)  the state the forces are evaluated at (x.w: inverse mass)
 //   vec4 acc_x(int i), acc_v(int i)  the running sums of a multi-pass combine
 // and the host defines PASS (one of the PASS_* below) and TOPOLOGY_GRID or TOPOLOGY_GENERAL.
+// With EXTERNAL_FORCES (the hybrid pipelines) another API's force pass wrote each node's
+// acceleration, which the including shader reads as vec4 forces_acc(int i).
 
 #define PASS_EXPLICIT_EULER 0
 #define PASS_SEMI_IMPLICIT_EULER 1
@@ -125,7 +127,11 @@ float displacement(vec3 x, vec3 x_old, vec3 v) {
 void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out vec4 o2, out vec4 o3) {
   float w = x0.w, dt = gravity_dt.w;
   vec3 xs = src_x(i).xyz, vs = src_v(i).xyz;
+#ifdef EXTERNAL_FORCES
+  vec3 a = forces_acc(i).xyz;
+#else
   vec3 a = acceleration(i, xs, vs, w);
+#endif
   vec3 x, v;
   o2 = vec4(0.0);
   o3 = vec4(0.0);

@@ -18,6 +18,10 @@ vec4 src_x(int j) { return src_x_[j]; }
 vec4 src_v(int j) { return src_v_[j]; }
 vec4 acc_x(int i) { return acc_x_[i]; }
 vec4 acc_v(int i) { return acc_v_[i]; }
+#ifdef EXTERNAL_FORCES
+layout(std430, binding = 11) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
+vec4 forces_acc(int i) { return forces_acc_[i]; }
+#endif
 
 #include "sim.glsl"
 

@@ -14,6 +14,10 @@ vec4 src_x(int j) { return texelFetch(u_src_x, j); }
 vec4 src_v(int j) { return texelFetch(u_src_v, j); }
 vec4 acc_x(int i) { return texelFetch(u_acc_x, i); }
 vec4 acc_v(int i) { return texelFetch(u_acc_v, i); }
+#ifdef EXTERNAL_FORCES
+layout(binding = 7) uniform samplerBuffer u_forces_acc;  // accelerations from the force stage
+vec4 forces_acc(int i) { return texelFetch(u_forces_acc, i); }
+#endif
 
 #include "sim.glsl"
 
