@@ -19,5 +19,8 @@ void add_cuda_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_GL
 void add_gl_bench(CLI::App& app);
 #endif
+#if DEFORMLAB_HAVE_INTEROP
+void add_hybrid_bench(CLI::App& app);
+#endif
 
 }  // namespace deformlab::bench

@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
 #if DEFORMLAB_HAVE_GL
   deformlab::bench::add_gl_bench(cli);
 #endif
+#if DEFORMLAB_HAVE_INTEROP
+  deformlab::bench::add_hybrid_bench(cli);
+#endif
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,198 @@
+// `deformlab-bench hybrid`: ms per step of the hybrid pipelines under each interop mode,
+// split by stage, against glsl-tf and cuda-fused, with host time per step beside GPU time.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "bench.hpp"
+#include "core/profiler.hpp"
+#include "core/state.hpp"
+#include "cuda_kernels/cuda_pipeline.hpp"
+#include "glsl_tf/context.hpp"
+#include "glsl_tf/pipelines_internal.hpp"
+#include "interop/calibrate.hpp"
+#include "interop/hybrid.hpp"
+
+namespace deformlab::bench {
+namespace {
+
+struct HybridOptions {
+  std::vector<int> sizes{64, 128, 256, 512, 1024, 2048};
+  std::vector<std::string> modes{"map", "external", "external-gpusync", "staged"};
+  std::vector<std::string> updates{"tf", "compute"};
+  std::string integrator = "semi-implicit-euler";
+  int warmup = 5, steps = 20;
+  std::string csv;
+  double floor_us = NAN;  // the calibrated floor; measured here when unset and external-gpusync is swept
+  bool baselines = true;  // also time cuda-fused and glsl-tf
+};
+
+Model bench_model(int n) {
+  Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
+  pin(m, pin_nodes(m, PinSet::top_corners, {}));
+  return m;
+}
+
+struct Row {
+  int n = 0;
+  std::string pipeline, mode;
+  double wall_ms = NAN;      // per step: host clock over all steps, drained at the end
+  double host_ms = NAN;      // per step: host clock inside step() (issuing, and any CPU wait)
+  double gpu_ms = NAN;       // per step, single-API pipelines: CUDA events or GL timer queries
+  double force_ms = NAN;     // per step: CUDA events
+  double update_ms = NAN;    // per step: GL timer queries
+  double hand_off_host_us = NAN;  // per step: host clock inside hand-off calls
+  double hand_off_us = NAN;  // per hand-off: (wall - force - update) / hand-offs
+  int hand_offs = 0;         // per step
+};
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Runs `steps` steps; returns {wall ms per step after a drain, host ms per step in step()}.
+std::pair<double, double> timed(Pipeline& p, int steps, Profiler* prof) {
+  p.max_displacement();  // drains the queued work
+  const auto t0 = std::chrono::steady_clock::now();
+  double host = 0.0;
+  for (int s = 1; s <= steps; ++s) {
+    if (prof) prof->set_step(s);
+    const auto h = std::chrono::steady_clock::now();
+    p.step();
+    host += ms_since(h);
+  }
+  p.max_displacement();
+  return {ms_since(t0) / steps, host / steps};
+}
+
+double stage_ms(const Profiler& prof, const char* name) {
+  for (const auto& g : prof.summary())
+    if (g.name == name) return g.median_ms;
+  return NAN;
+}
+
+std::string fixed(double v, int prec) {
+  if (std::isnan(v)) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(prec) << v;
+  return s.str();
+}
+
+void run_hybrid(const HybridOptions& o) {
+  const auto integ = parse_integrator(o.integrator);
+  if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
+  const gl::ContextInfo& ctx = gl::context();
+  const int dev = interop::cuda_device_of_gl();
+  const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();
+  const double floor_us = !std::isnan(o.floor_us) ? o.floor_us : gpusync ? interop::hand_off_floor_us(2000) : NAN;
+  Params params;
+  params.dt = 0.001f;
+  const int passes = info(*integ).force_passes;
+  std::cout << "deformlab-bench hybrid: CUDA device " << dev << ", GL " << ctx.renderer << "\n"
+            << "cloth n x n, top corners pinned, " << o.integrator << ", dt 1 ms, from rest; " << o.warmup
+            << " warm-up steps, then " << o.steps << " timed steps.\n"
+            << "wall: host clock over the timed steps, drained at the end, per step. host: host clock inside step().\n"
+            << "gpu: CUDA events (cuda-fused), GL timer queries (glsl-tf), median per step. force: CUDA events;\n"
+            << "update: GL timer queries (median per step). hand-off: (wall - force - update) / hand-offs per step\n"
+            << "(" << 2 * passes << "); ho-host: host clock inside the hand-off calls per step. floor: GL<->CUDA\n"
+            << "semaphore ping-pong with no work, " << fixed(floor_us, 1) << " us per hand-off. bound: wall <= 1.05 x\n"
+            << "(update + force + " << 2 * passes << " floors).\n\n";
+  std::ofstream csv;
+  if (!o.csv.empty()) {
+    csv.open(o.csv);
+    if (!csv) throw std::invalid_argument("cannot write " + o.csv);
+    csv << "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us\n";
+  }
+  std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
+            << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
+            << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)
+            << "ho-host us" << std::setw(7) << "bound" << "\n";
+  auto print = [&](const Row& r) {
+    const double bound = 1.05 * (r.update_ms + r.force_ms + 2 * passes * floor_us * 1e-3);
+    std::cout << std::setw(6) << r.n << std::setw(16) << r.pipeline << std::setw(18) << r.mode << std::setw(10)
+              << fixed(r.wall_ms, 3) << std::setw(10) << fixed(r.host_ms, 3) << std::setw(10) << fixed(r.gpu_ms, 3)
+              << std::setw(10) << fixed(r.force_ms, 3) << std::setw(11) << fixed(r.update_ms, 3) << std::setw(13)
+              << fixed(r.hand_off_us, 1) << std::setw(10) << fixed(r.hand_off_us / floor_us, 2) << std::setw(13)
+              << fixed(r.hand_off_host_us, 1) << std::setw(7)
+              << (std::isnan(r.force_ms) ? "" : r.wall_ms <= bound ? "ok" : "over") << std::endl;
+    if (csv)
+      csv << r.n << "," << r.pipeline << "," << r.mode << "," << r.wall_ms << "," << r.host_ms << "," << r.gpu_ms << ","
+          << r.force_ms << "," << r.update_ms << "," << r.hand_off_us << "," << r.hand_off_host_us << "," << floor_us
+          << "\n";
+  };
+
+  for (int n : o.sizes) {
+    const Model m = bench_model(n);
+    const PipelineSetup setup{m, params, *integ};
+    if (o.baselines) {
+      auto p = cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true});
+      p->set_state(rest_state(m));
+      p->timed_steps(o.warmup);
+      Row r{n, "cuda-fused", "-"};
+      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
+      r.gpu_ms = p->timed_steps(o.steps) / o.steps;
+      print(r);
+    }
+    if (o.baselines) {
+      auto p = gl::make_tf_update(setup, nullptr);
+      p->set_state(rest_state(m));
+      for (int s = 0; s < o.warmup; ++s) p->step();
+      p->take_step_ms();
+      Row r{n, "glsl-tf", "-"};
+      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
+      std::vector<double> gpu = p->take_step_ms();
+      r.gpu_ms = stats(gpu).median;
+      print(r);
+    }
+    for (const auto& u : o.updates)
+      for (const auto& mode_name : o.modes) {
+        const auto mode = interop::parse_mode(mode_name);
+        if (!mode) throw std::invalid_argument("unknown interop mode " + mode_name);
+        Row r{n, u == "compute" ? "hybrid-compute" : "hybrid", mode_name};
+        if (const std::string why = interop::unavailable(*mode); !why.empty()) {
+          std::cout << std::setw(6) << n << std::setw(16) << r.pipeline << std::setw(18) << mode_name
+                    << "  unavailable: " << why << "\n";
+          continue;
+        }
+        auto p = interop::make_hybrid_pipeline(
+            setup, {u == "compute" ? interop::Update::compute : interop::Update::transform_feedback, *mode,
+                    cuda::Variant::naive});
+        p->set_state(rest_state(m));
+        for (int s = 0; s < o.warmup; ++s) p->step();
+        Profiler prof;
+        p->set_profiler(&prof);
+        std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, &prof);
+        p->set_profiler(nullptr);
+        r.force_ms = stage_ms(prof, span::force);
+        r.update_ms = stage_ms(prof, span::update);
+        r.hand_off_host_us = stage_ms(prof, span::hand_off) * 1e3;
+        r.hand_offs = 2 * passes;
+        r.hand_off_us = (r.wall_ms - r.force_ms - r.update_ms) * 1e3 / r.hand_offs;
+        print(r);
+      }
+  }
+}
+
+}  // namespace
+
+void add_hybrid_bench(CLI::App& app) {
+  auto o = std::make_shared<HybridOptions>();
+  auto* c = app.add_subcommand("hybrid", "Hybrid pipelines per interop mode, split by stage, against glsl-tf and "
+                                         "cuda-fused");
+  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
+  c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
+  c->add_option("--updates", o->updates, "Update passes: tf, compute");
+  c->add_option("--integrator", o->integrator, "Integrator");
+  c->add_option("--warmup", o->warmup, "Warm-up steps")->check(CLI::PositiveNumber);
+  c->add_option("--steps", o->steps, "Timed steps")->check(CLI::PositiveNumber);
+  c->add_option("--csv", o->csv, "Also write every row to this CSV file");
+  c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
+  c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
+  c->callback([o] { run_hybrid(*o); });
+}
+
+}  // namespace deformlab::bench

@@ -1,0 +1,31 @@
+// The hybrid pipelines: a CUDA force pass writes each node's acceleration into a buffer
+// shared with GL; a GL update pass (transform feedback or compute shader) integrates and
+// applies the constraints, ping-ponging as glsl-tf does. Multi-evaluation integrators
+// alternate CUDA force passes and GL update passes: two hand-offs per force pass.
+#pragma once
+#include <memory>
+
+#include "core/pipeline.hpp"
+#include "cuda_kernels/cuda_pipeline.hpp"
+#include "shared_buffers.hpp"
+
+namespace deformlab::interop {
+
+enum class Update { transform_feedback, compute };
+
+struct HybridOptions {
+  Update update = Update::transform_feedback;
+  Mode mode = Mode::map;
+  cuda::Variant force = cuda::Variant::naive;  // naive, tiled or scatter
+  cuda::Tile tile;                              // thread block of the grid force kernels
+};
+
+// Reads the pipeline options `interop`, `force` and `tile` (throws std::invalid_argument on a
+// bad value).
+HybridOptions hybrid_options(const PipelineOptions& o, Update u);
+// Empty when the integrator runs on the hybrid pipelines, else why not.
+std::string hybrid_unsupported(Integrator i);
+// Throws std::invalid_argument naming what is missing (CUDA, GL, the interop mode's needs).
+std::unique_ptr<Pipeline> make_hybrid_pipeline(const PipelineSetup& s, const HybridOptions& o);
+
+}  // namespace deformlab::interop

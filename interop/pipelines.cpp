@@ -1,0 +1,29 @@
+#include "pipelines.hpp"
+
+#include "glsl_tf/context.hpp"
+#include "hybrid.hpp"
+
+namespace deformlab {
+
+void add_hybrid_pipelines(PipelineRegistry& r) {
+  using interop::Update;
+  // Available when CUDA and GL are, with a CUDA device behind the GL context; the interop
+  // mode's own needs are checked when the pipeline is made (they depend on the option).
+  auto unavailable = [] { return interop::unavailable(interop::Mode::map); };
+  auto unsupported = [](Integrator i) { return interop::hybrid_unsupported(i); };
+  const std::vector<std::string> options = {"interop", "force", "tile"};
+  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile)", true, unavailable,
+         unsupported,
+         [](const PipelineSetup& s) {
+           return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
+         },
+         options});
+  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile)", true,
+         unavailable, unsupported,
+         [](const PipelineSetup& s) {
+           return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
+         },
+         options});
+}
+
+}  // namespace deformlab

@@ -1,0 +1,115 @@
+// The GL update passes fed by an outside force stage (what the hybrid pipelines do with
+// CUDA), here with the accelerations computed on the host from the state GL wrote, so that
+// the GL side of the hybrid step is checked on any GL driver (llvmpipe in CI). Tolerance:
+// as for the hybrid pipelines (hybrid_test.cpp): 8 x the CPU float pipeline's own distance
+// from the double reference, with a floor of 1e-6 m and 1e-4 m/s.
+#include <gtest/gtest.h>
+
+#include "core/cpu_backend.hpp"
+#include "core/forces.hpp"
+#include "glsl_tf/gl_pipeline.hpp"
+#include "glsl_tf/pipelines_internal.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+// Accelerations on the host with the formulas of core/forces.hpp, summed in the adjacency
+// order of the CPU pipeline.
+class HostForces final : public gl::ExternalForces {
+ public:
+  HostForces(const Model& m, const Params& p) : m_(m), p_(p) {}
+
+  GLuint node_buffer(std::size_t bytes, gl::NodeRole) override {
+    buffers_.push_back(gl::make_buffer(bytes));
+    return buffers_.back().id();
+  }
+
+  void forces(GLuint x, GLuint v, GLuint acc, double t) override {
+    const std::size_t n = std::size_t(m_.node_count());
+    std::vector<float> xs(4 * n), vs(4 * n), a(4 * n, 0.f);
+    gl::read_buffer(x, xs.size() * 4, xs.data());
+    gl::read_buffer(v, vs.size() * 4, vs.data());
+    auto at = [](const std::vector<float>& b, int i) { return Vec3f{b[4 * i], b[4 * i + 1], b[4 * i + 2]}; };
+    const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
+    const Vec3f target = spring_drag ? p_.drag.target(t) : Vec3f{};
+    for (int i = 0; i < int(n); ++i) {
+      const float w = m_.inv_mass[i];
+      if (w == 0.f) continue;
+      Vec3f f{};
+      for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
+        const int sp = m_.adj_spring[e], j = m_.adj_node[e], k = int(m_.kind[sp]);
+        f += spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), m_.stiffness[k], m_.damping[k], m_.rest_length[sp]);
+      }
+      if (spring_drag && i == p_.drag.node) f += (target - at(xs, i)) * p_.drag.stiffness;
+      const Vec3f ai = acceleration(f, at(vs, i), w, p_.damping, p_.wind, p_.gravity);
+      a[4 * i] = ai.x;
+      a[4 * i + 1] = ai.y;
+      a[4 * i + 2] = ai.z;
+    }
+    glNamedBufferSubData(acc, 0, GLsizeiptr(a.size() * 4), a.data());
+    ++calls;
+  }
+
+  int calls = 0;
+
+ private:
+  const Model& m_;
+  const Params& p_;
+  std::vector<gl::Buffer> buffers_;
+};
+
+struct Case {
+  bool compute;
+  Integrator integrator;
+};
+
+class GlUpdatePass : public testing::TestWithParam<Case> {};
+
+TEST_P(GlUpdatePass, MatchesTheCpuPipeline) {
+  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
+  const Case& c = GetParam();
+  Model m = small_cloth(16, 12);
+  m.damping = {0.02f, 0.02f, 0.01f};
+  Params p = small_params();
+  if (c.integrator == Integrator::explicit_euler) p.dt = 1e-4f;
+  p.wind = {0.002f, 0.f, -0.001f};
+  p.drag.node = m.node_count() / 2 + 3;
+  p.drag.as_spring = true;
+  p.drag.stiffness = 50.f;
+  p.drag.path = {{0.f, m.rest_position[p.drag.node]}, {0.1f, m.rest_position[p.drag.node] + Vec3f{0.05f, 0.02f, 0.f}}};
+  const State s0 = perturbed_state(m, 11);
+  const int steps = 30;
+  const PipelineSetup setup{m, p, c.integrator};
+  HostForces forces(m, p);
+  auto gpu = c.compute ? gl::make_compute_update(setup, &forces) : gl::make_tf_update(setup, &forces);
+  auto f32 = make_cpu_pipeline(setup, Precision::f32, false);
+  auto f64 = make_cpu_pipeline(setup, Precision::f64, false);
+  const State g = advance(*gpu, s0, steps), a = advance(*f32, s0, steps), r = advance(*f64, s0, steps);
+  EXPECT_EQ(forces.calls, steps * info(c.integrator).force_passes);
+  const double tol_x = std::max(8.0 * max_position_diff(a, r), 1e-6);
+  const double tol_v = std::max(8.0 * max_velocity_diff(a, r), 1e-4);
+  EXPECT_LE(max_position_diff(g, a), tol_x);
+  EXPECT_LE(max_velocity_diff(g, a), tol_v);
+  EXPECT_NEAR(g.t, a.t, 1e-9);
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  for (bool compute : {false, true})
+    for (const auto& i : integrators())
+      if (i.id != Integrator::backward_euler) out.push_back({compute, i.id});
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Gl, GlUpdatePass, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<Case>& p) {
+                           std::string s = std::string(p.param.compute ? "compute_" : "tf_") +
+                                           std::string(deformlab::info(p.param.integrator).name);
+                           for (char& ch : s)
+                             if (ch == '-') ch = '_';
+                           return s;
+                         });
+
+}  // namespace
+}  // namespace deformlab::test
