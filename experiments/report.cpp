@@ -159,7 +159,10 @@ fs::path write_report(const fs::path& dir) {
         }
         const json& r = *it->second;
         if (r["status"] == "ok") {
-          md << " " << fmt(r["median_ms"]) << " |";
+          md << " " << fmt(r["median_ms"]);
+          if (!r.value("stable", true))
+            md << " [" << note("the state was not finite after the timed steps: the time of a wrong result", c.label + " " + std::to_string(n) + "²") << "]";
+          md << " |";
           series[k].x.push_back(r["nodes"].get<double>());
           series[k].y.push_back(r["median_ms"].get<double>());
         } else {
@@ -200,7 +203,7 @@ fs::path write_report(const fs::path& dir) {
     md << "\n![" << t.title << "](" << svg << ")\n\n";
   }
   if (!notes.empty()) {
-    md << "## Cells not measured\n\n";
+    md << "## Notes on cells\n\n";
     for (std::size_t k = 0; k < notes.size(); ++k) {
       md << "[" << k + 1 << "] " << notes[k].first << " (";
       for (std::size_t w = 0; w < notes[k].second.size(); ++w) md << (w ? ", " : "") << notes[k].second[w];

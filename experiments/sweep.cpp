@@ -270,10 +270,13 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   ModelCache cache;
   for (const auto& c : all) {
     const fs::path file = dir / "cells" / (c.id() + ".json");
+    // A measured cell is done; an n/a one is tried again (the build or machine may differ).
     json r;
     if (fs::exists(file)) {
       std::ifstream in(file);
       r = json::parse(in);
+    }
+    if (r.is_object() && r["status"] == "ok") {
       ++prog.skipped;
     } else {
       r = run_cell(x, s, c, cache);

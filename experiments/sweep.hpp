@@ -48,7 +48,8 @@ struct SweepOptions {
   std::function<void(const Cell&, const nlohmann::json& result, const SweepProgress&)> on_cell;
 };
 
-// Runs every cell not yet in `dir`/cells/ and returns the number it ran. Writes
+// Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again) and returns
+// the number it ran. Writes
 // `dir`/manifest.json (experiment, build, machine) first.
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
