@@ -23,6 +23,10 @@ class CpuPipeline final : public Pipeline {
   };
 
  public:
+  // OpenMP threads: at least kNodesPerThread nodes each, so that small models do not pay
+  // for more barriers than they have work (a thread more changes no result).
+  static constexpr int kNodesPerThread = 1024;
+
   CpuPipeline(const PipelineSetup& s, bool parallel)
       : m_(s.model),
         p_(s.params),
@@ -293,9 +297,6 @@ class CpuPipeline final : public Pipeline {
   const Model& m_;
   Params p_;
   Schedule sched_;
-  // OpenMP threads: at least kNodesPerThread nodes each, so that small models do not pay
-  // for more barriers than they have work (a thread more changes no result).
-  static constexpr int kNodesPerThread = 1024;
   int threads_;
   std::vector<Slot> slots_;  // 0: current state, 1..: stage states
   std::vector<std::vector<V>> acc_;
@@ -318,8 +319,9 @@ void add_cpu_pipelines(PipelineRegistry& r) {
   auto every = [](Integrator) { return std::string(); };
   r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", true, always, every,
          [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }});
-  r.add({"omp", "OpenMP float, " + std::to_string(omp_get_max_threads()) +
-                    " threads (the paper's optimised CPU); bitwise equal to cpu",
+  r.add({"omp", "OpenMP float, up to " + std::to_string(omp_get_max_threads()) + " threads of at least " +
+                    std::to_string(CpuPipeline<float>::kNodesPerThread) +
+                    " nodes each (the paper's optimised CPU); bitwise equal to cpu",
          true, always, every,
          [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }});
   r.add({"reference", "OpenMP double: the reference for tests and --compare", true, always, every,
