@@ -285,19 +285,23 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(Scene s, Stencil st, co
 
 // ---- general models: one thread per node over the CSR adjacency ----
 
+// Node i's acceleration; pinned and hard-dragged nodes skip the gather.
+__device__ __forceinline__ Vec3f csr_accel(const Scene& s, const int* __restrict__ offset,
+                                           const Link* __restrict__ links, const float4* __restrict__ x,
+                                           const float4* __restrict__ v, int i, const float4& x4, const float4& v4,
+                                           const Vec3f& drag_target) {
+  if (fixed(s, i, x4.w)) return {};
+  const Vec3f xi = xyz(x4), vi = xyz(v4);
+  return node_accel(s, i, x4.w, xi, vi, gather_csr(s, offset, links, x, v, i, xi, vi), drag_target);
+}
+
 __global__ void force_csr(Scene s, const int* __restrict__ offset, const Link* __restrict__ links,
                           const float4* __restrict__ x, const float4* __restrict__ v, float4* __restrict__ acc,
                           Vec3f drag_target) {
   const std::int64_t t = thread_index();
   if (t >= s.n) return;
   const int i = int(t);
-  const float4 x4 = x[i], v4 = v[i];
-  Vec3f a{};
-  if (!fixed(s, i, x4.w)) {
-    const Vec3f xi = xyz(x4), vi = xyz(v4);
-    a = node_accel(s, i, x4.w, xi, vi, gather_csr(s, offset, links, x, v, i, xi, vi), drag_target);
-  }
-  acc[i] = f4(a, 0.f);
+  acc[i] = f4(csr_accel(s, offset, links, x, v, i, x[i], v[i], drag_target), 0.f);
 }
 
 template <Integrator I>
@@ -308,11 +312,7 @@ __global__ void fused_csr(Scene s, const int* __restrict__ offset, const Link* _
   if (t >= s.n) return;
   const int i = int(t);
   const float4 x4 = x[i], v4 = v[i];
-  Vec3f a{};
-  if (!fixed(s, i, x4.w)) {
-    const Vec3f xi = xyz(x4), vi = xyz(v4);
-    a = node_accel(s, i, x4.w, xi, vi, gather_csr(s, offset, links, x, v, i, xi, vi), tg.force);
-  }
+  const Vec3f a = csr_accel(s, offset, links, x, v, i, x4, v4, tg.force);
   advance_node<I>(s, i, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
 }
 
