@@ -197,6 +197,11 @@ class ExternalBuffers final : public SharedBuffers {
     Entry e;
     e.memory = std::make_unique<ExportableAllocation>(device_, bytes);
     glCreateMemoryObjectsEXT(1, &e.gl_memory);
+    // cuMemCreate memory is one allocation per buffer: GL must be told so. Imported without
+    // this flag, the NVIDIA driver accepts the fd without an error but the GL buffer does not
+    // see CUDA's memory (seen on the H100 at every size).
+    const GLint dedicated = GL_TRUE;
+    glMemoryObjectParameterivEXT(e.gl_memory, GL_DEDICATED_MEMORY_OBJECT_EXT, &dedicated);
     glImportMemoryFdEXT(e.gl_memory, e.memory->size(), GL_HANDLE_TYPE_OPAQUE_FD_EXT, e.memory->export_fd());
     GLuint id = 0;
     glCreateBuffers(1, &id);
