@@ -16,6 +16,9 @@ inline constexpr const char* step = "step";
 inline constexpr const char* force = "force";
 inline constexpr const char* hand_off = "hand-off";
 inline constexpr const char* update = "update";
+// One pass that evaluates the forces and integrates (cuda-fused, the glsl-tf and
+// glsl-compute passes): the two stages cannot be timed apart.
+inline constexpr const char* force_update = "force+update";
 inline constexpr const char* constraints = "constraints";
 inline constexpr const char* reductions = "reductions";
 inline constexpr const char* render = "render";

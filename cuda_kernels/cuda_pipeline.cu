@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "check.cuh"
+#include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
 #include "force_stage.hpp"
 #include "kernels.cuh"
@@ -332,7 +333,8 @@ class Impl final : public CudaPipeline, private ForceKernels {
   }
 
   void step() override {
-    const bool replay = o_.graphs && time_invariant() && !(sched_.integrator == Integrator::verlet && !has_prev_);
+    // Profiled steps run pass by pass (a graph replay has no spans).
+    const bool replay = !prof_ && o_.graphs && time_invariant() && !(sched_.integrator == Integrator::verlet && !has_prev_);
     if (replay) {
       if (!graph_[cur_]) capture(cur_);
       check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");
@@ -374,6 +376,11 @@ class Impl final : public CudaPipeline, private ForceKernels {
     e.field = ne.field;
     e.spring = se;
     return e;
+  }
+
+  void set_profiler(Profiler* p) override {
+    spans_.collect(prof_);
+    prof_ = p;
   }
 
   double timed_steps(int steps) override {
@@ -452,16 +459,28 @@ class Impl final : public CudaPipeline, private ForceKernels {
   const float4* slot_v(int k) const { return k == 0 ? v_[cur_].get() : sv_[k - 1].get(); }
 
   void enqueue_step() {
-    if (fused_) return fused_step();
+    if (fused_) return timed(span::force_update, [&] { fused_step(); });
     for (const Pass& pass : sched_.passes) {
       switch (pass.op) {
-        case Pass::Op::force: force_pass(pass.src, pass.acc, targets(pass.time_fraction).force); break;
-        case Pass::Op::stage: stage_pass(pass); break;
-        case Pass::Op::combine: combine_pass(pass); break;
-        case Pass::Op::fused: update_pass(); break;
+        case Pass::Op::force:
+          timed(span::force, [&] { force_pass(pass.src, pass.acc, targets(pass.time_fraction).force); });
+          break;
+        case Pass::Op::stage: timed(span::update, [&] { stage_pass(pass); }); break;
+        case Pass::Op::combine: timed(span::update, [&] { combine_pass(pass); }); break;
+        case Pass::Op::fused: timed(span::update, [&] { update_pass(); }); break;
         case Pass::Op::solve: throw std::logic_error("solve pass on a CUDA pipeline");
       }
     }
+  }
+
+  // Runs `launch`, timed as a span named `name` when a profiler is attached.
+  template <class F>
+  void timed(const char* name, F&& launch) {
+    if (!prof_) return launch();
+    spans_.begin(*prof_, name, stream_);
+    launch();
+    spans_.end(stream_);
+    if (spans_.pending() > 1024) spans_.collect(prof_);
   }
 
   // The checks in the order their errors are reported, before anything is allocated.
@@ -553,6 +572,8 @@ class Impl final : public CudaPipeline, private ForceKernels {
   }
 
   Params p_;
+  Profiler* prof_ = nullptr;
+  EventSpans spans_;  // force / update / force+update spans while profiled
   Schedule sched_;
   int n_ = 0;
   bool fused_ = false;

@@ -321,4 +321,26 @@ std::string Timer::method() const {
                    : "GL timer queries (GL_TIME_ELAPSED)";
 }
 
+void TimerSpans::begin(const Profiler& p, const char* name) {
+  if (!timer_) timer_ = std::make_unique<Timer>();
+  pending_.push_back({name, p.step(), p.now_ms()});
+  range_.emplace(name);
+  timer_->begin();
+}
+
+void TimerSpans::end() {
+  timer_->end();
+  range_.reset();
+}
+
+void TimerSpans::collect(Profiler* p) {
+  if (pending_.empty()) return;
+  const std::vector<double> ms = timer_->take();
+  for (std::size_t k = 0; k < pending_.size() && k < ms.size(); ++k)
+    if (p) p->add({pending_[k].name, pending_[k].step, pending_[k].start_ms, ms[k], timer_->method()});
+  pending_.clear();
+}
+
+std::string TimerSpans::method() const { return timer_ ? timer_->method() : Timer().method(); }
+
 }  // namespace deformlab::gl

@@ -5,9 +5,13 @@
 #include <GL/glew.h>
 
 #include <chrono>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "core/profiler.hpp"
 
 namespace deformlab::gl {
 
@@ -61,6 +65,30 @@ class Timer {
   std::vector<unsigned> free_, pending_;
   std::vector<double> done_;
   std::chrono::steady_clock::time_point t0_;
+};
+
+// Profiler spans of GL work, timed by a Timer and handed to the profiler once resolved
+// (resolving waits for the work). Spans may not nest, nor overlap another Timer's spans.
+class TimerSpans {
+ public:
+  // A span of the GL commands issued between begin and end, at the profiler's current step
+  // and host time, with an NVTX range of the same name over the host side.
+  void begin(const Profiler& p, const char* name);
+  void end();
+  // Waits for the pending spans and adds them to `p` (null: drops them).
+  void collect(Profiler* p);
+  std::size_t pending() const { return pending_.size(); }
+  std::string method() const;
+
+ private:
+  struct Pending {
+    const char* name;
+    int step;
+    double start_ms;
+  };
+  std::unique_ptr<Timer> timer_;  // made on first use
+  std::vector<Pending> pending_;
+  std::optional<NvtxRange> range_;
 };
 
 }  // namespace deformlab::gl

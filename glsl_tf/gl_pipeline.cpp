@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace deformlab::gl {
 namespace {
@@ -308,7 +309,13 @@ void GlPipeline::step() {
   const double dt = p_.dt;
   const Vec3f next = p_.drag.active() ? p_.drag.target(t_ + dt) : Vec3f{};
   // With an external force stage, it times the passes (GL timer spans may not nest).
-  if (!forces_) timer_->begin();
+  if (!forces_) {
+    if (prof_) {
+      if (profiled_.size() >= 512) collect_steps();
+      profiled_.push_back({prof_->step(), prof_->now_ms()});
+    }
+    timer_->begin();
+  }
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
   bind_model_textures();
   for (const GpuPass& g : passes_) {
@@ -354,6 +361,26 @@ void GlPipeline::step() {
   t_ += dt;
   stepped_ = true;
   if (integrator_ == Integrator::verlet) has_prev_ = true;
+}
+
+void GlPipeline::collect_steps() {
+  const std::vector<double> ms = timer_->take();
+  if (prof_)
+    for (std::size_t k = 0; k < ms.size() && k < profiled_.size(); ++k)
+      prof_->add({span::force_update, profiled_[k].step, profiled_[k].start_ms, ms[k], timer_->method()});
+  profiled_.clear();
+  step_ms_.insert(step_ms_.end(), ms.begin(), ms.end());
+}
+
+std::vector<double> GlPipeline::take_step_ms() {
+  collect_steps();
+  return std::exchange(step_ms_, {});
+}
+
+void GlPipeline::set_profiler(Profiler* p) {
+  if (forces_) return;  // the external force stage times the passes
+  collect_steps();
+  prof_ = p;
 }
 
 double GlPipeline::max_displacement() {

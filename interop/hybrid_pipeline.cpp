@@ -1,10 +1,9 @@
 #include <cuda_runtime.h>
 
-#include <deque>
-#include <optional>
 #include <stdexcept>
 
 #include "cuda_kernels/check.cuh"
+#include "cuda_kernels/event_spans.hpp"
 #include "cuda_kernels/force_stage.hpp"
 #include "glsl_tf/gl_pipeline.hpp"
 #include "glsl_tf/pipelines_internal.hpp"
@@ -46,13 +45,6 @@ class HybridForces final : public gl::ExternalForces {
  public:
   HybridForces(const Params& p, SharedBuffers& sb, cuda::ForceStage& fs) : p_(p), sb_(sb), fs_(fs) {}
 
-  ~HybridForces() override {
-    for (auto& e : events_) {
-      cudaEventDestroy(e.begin);
-      cudaEventDestroy(e.end);
-    }
-  }
-
   GLuint node_buffer(std::size_t bytes, gl::NodeRole role) override {
     return sb_.add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
   }
@@ -63,36 +55,21 @@ class HybridForces final : public gl::ExternalForces {
       HostSpan h(prof_, span::hand_off);
       sb_.to_cuda({x, v, acc});
     }
-    {
-      NvtxRange range(span::force);
-      Pending f{span::force, prof_ ? prof_->step() : 0, prof_ ? prof_->now_ms() : 0.0, -1};
-      if (prof_) {
-        f.events = take_events();
-        cuda::check(cudaEventRecord(events_[f.events].begin, sb_.stream()), "recording the force pass start");
-      }
-      fs_.run(static_cast<const float4*>(sb_.cuda_ptr(x)), static_cast<const float4*>(sb_.cuda_ptr(v)),
-              static_cast<float4*>(sb_.cuda_ptr(acc)), target, sb_.stream());
-      if (prof_) {
-        cuda::check(cudaEventRecord(events_[f.events].end, sb_.stream()), "recording the force pass end");
-        pending_.push_back(f);
-      }
-    }
+    if (prof_) force_spans_.begin(*prof_, span::force, sb_.stream());
+    fs_.run(static_cast<const float4*>(sb_.cuda_ptr(x)), static_cast<const float4*>(sb_.cuda_ptr(v)),
+            static_cast<float4*>(sb_.cuda_ptr(acc)), target, sb_.stream());
+    if (prof_) force_spans_.end(sb_.stream());
     {
       HostSpan h(prof_, span::hand_off);
       sb_.to_gl();
     }
-    if (prof_) {
-      update_range_.emplace(span::update);
-      pending_.push_back({span::update, prof_->step(), prof_->now_ms(), -1});
-      gl_timer().begin();
-    }
+    if (prof_) update_spans_.begin(*prof_, span::update);
   }
 
   void update_issued() override {
     if (!prof_) return;
-    gl_timer().end();
-    update_range_.reset();
-    if (pending_.size() > 512) collect();
+    update_spans_.end();
+    if (force_spans_.pending() > 512) collect();
   }
 
   // Spans still pending go to the profiler they were taken for.
@@ -102,67 +79,17 @@ class HybridForces final : public gl::ExternalForces {
   }
 
  private:
-  struct Pending {
-    const char* name;
-    int step;
-    double start_ms;
-    int events;  // CUDA event pair (force), -1: a GL timer span (update)
-  };
-  struct EventPair {
-    cudaEvent_t begin = nullptr, end = nullptr;
-  };
-
-  gl::Timer& gl_timer() {
-    if (!timer_) timer_ = std::make_unique<gl::Timer>();
-    return *timer_;
-  }
-
-  int take_events() {
-    if (!free_events_.empty()) {
-      const int k = free_events_.back();
-      free_events_.pop_back();
-      return k;
-    }
-    EventPair e;
-    cuda::check(cudaEventCreate(&e.begin), "creating a timing event");
-    cuda::check(cudaEventCreate(&e.end), "creating a timing event");
-    events_.push_back(e);
-    return int(events_.size()) - 1;
-  }
-
-  // Resolves every pending span (waits for its GPU work) and hands it to the profiler.
   void collect() {
-    if (pending_.empty()) return;
-    std::vector<double> gl_ms = timer_ ? timer_->take() : std::vector<double>{};
-    std::size_t next_gl = 0;
-    for (const Pending& s : pending_) {
-      Span out{s.name, s.step, s.start_ms, 0.0, ""};
-      if (s.events >= 0) {
-        const EventPair& e = events_[s.events];
-        cuda::check(cudaEventSynchronize(e.end), "waiting for a timed force pass");
-        float ms = 0.f;
-        cuda::check(cudaEventElapsedTime(&ms, e.begin, e.end), "reading a force pass timer");
-        out.ms = ms;
-        out.clock = "CUDA events";
-        free_events_.push_back(s.events);
-      } else {
-        out.ms = next_gl < gl_ms.size() ? gl_ms[next_gl++] : 0.0;
-        out.clock = timer_ ? timer_->method() : "GL timer queries";
-      }
-      if (prof_) prof_->add(std::move(out));
-    }
-    pending_.clear();
+    force_spans_.collect(prof_);
+    update_spans_.collect(prof_);
   }
 
   const Params& p_;
   SharedBuffers& sb_;
   cuda::ForceStage& fs_;
   Profiler* prof_ = nullptr;
-  std::unique_ptr<gl::Timer> timer_;
-  std::optional<NvtxRange> update_range_;
-  std::vector<EventPair> events_;
-  std::vector<int> free_events_;
-  std::vector<Pending> pending_;
+  cuda::EventSpans force_spans_;
+  gl::TimerSpans update_spans_;
 };
 
 class HybridPipeline final : public Pipeline {

@@ -14,7 +14,9 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/energy.hpp"
 #include "cuda_kernels/pipelines.hpp"
@@ -270,6 +272,46 @@ TEST(CudaPipeline, ParsesTileShapes) {
   EXPECT_EQ(cuda::parse_tile("16x8").y, 8);
   for (const char* bad : {"", "16", "0x8", "x8", "16x", "64x64", "8x8x", "a8x8"})
     EXPECT_THROW(cuda::parse_tile(bad), std::invalid_argument) << bad;
+}
+
+// Profiled steps: the split pipelines time their force and update passes apart (midpoint:
+// two of each per step), cuda-fused its one force+update kernel, all by CUDA events; a
+// profiled run (pass by pass) ends in the same state as an unprofiled one (graph replays).
+// (The variants here are deterministic; cuda-scatter's atomics are not bitwise repeatable.)
+TEST(CudaProfile, SpansPerPassAndTheSameState) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = small_cloth(24, 20);
+  const Params p = small_params();
+  const State s0 = perturbed_state(m, 5);
+  for (const auto& [variant, integ, expect] :
+       {std::tuple{cuda::Variant::naive, Integrator::midpoint, std::map<std::string, int>{{"force", 2}, {"update", 2}}},
+        std::tuple{cuda::Variant::tiled, Integrator::semi_implicit_euler,
+                   std::map<std::string, int>{{"force", 1}, {"update", 1}}},
+        std::tuple{cuda::Variant::fused, Integrator::verlet, std::map<std::string, int>{{"force+update", 1}}}}) {
+    SCOPED_TRACE(cuda::to_string(variant));
+    auto profiled = cuda::make_pipeline({m, p, integ}, {variant});
+    Profiler prof;
+    profiled->set_state(s0);
+    profiled->set_profiler(&prof);
+    constexpr int steps = 6;
+    for (int k = 1; k <= steps; ++k) {
+      prof.set_step(k);
+      profiled->step();
+    }
+    profiled->set_profiler(nullptr);  // collects the pending spans
+    std::map<std::string, int> count;
+    for (const Span& s : prof.spans()) {
+      ++count[s.name];
+      EXPECT_EQ(s.clock, "CUDA events");
+      EXPECT_GT(s.ms, 0.0) << s.name;
+      EXPECT_GE(s.step, 1);
+    }
+    std::map<std::string, int> per_step;
+    for (const auto& [name, n] : expect) per_step[name] = n * steps;
+    EXPECT_EQ(count, per_step);
+    auto plain = cuda::make_pipeline({m, p, integ}, {variant});
+    EXPECT_TRUE(bitwise_equal(advance(*plain, s0, steps), profiled->state()));
+  }
 }
 
 }  // namespace
