@@ -77,12 +77,15 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces*
   if (n_ < 1) throw std::invalid_argument(name_ + ": the model has no nodes");
   if (int(p_.spheres.size()) > kMaxSpheres)
     throw std::invalid_argument(name_ + " supports at most " + std::to_string(kMaxSpheres) + " spheres");
+  stencil_ = grid_stencil(m_);
+  // Node states are texture buffers of one texel per node; a model without a grid stencil
+  // also has its adjacency in texture buffers (two entries per spring).
   GLint max_texels = 0;
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
-  if (std::int64_t(2) * m_.spring_count() > max_texels || n_ + 1 > max_texels)
+  const std::int64_t adjacency = stencil_.empty() ? std::int64_t(2) * m_.spring_count() : 0;
+  if (adjacency > max_texels || n_ + 1 > max_texels)
     throw std::invalid_argument(name_ + ": the model needs texture buffers larger than this driver's " +
                                 std::to_string(max_texels) + " texels");
-  stencil_ = grid_stencil(m_);
   timer_ = std::make_unique<Timer>();
 
   const std::size_t bytes = std::size_t(n_) * 16;
