@@ -1,5 +1,6 @@
 // `deformlab calibrate`: this device's ceilings as JSON (see interop/calibrate.hpp).
 #include <iostream>
+#include <stdexcept>
 
 #include "commands.hpp"
 #include "experiments/output.hpp"
@@ -9,13 +10,30 @@
 
 namespace deformlab::app {
 
-int calibrate_command(const CalibrateArgs& a) {
+nlohmann::json measure_calibration(const std::vector<std::string>& argv) {
 #if DEFORMLAB_HAVE_INTEROP
+  nlohmann::json j = interop::calibrate({}, std::cerr);
+  j["command"] = argv;
+  j["build"] = build_info();
+  j["machine"] = machine_info();
+  return j;
+#else
+  (void)argv;
+  throw std::invalid_argument(
+      "calibrate measures CUDA and OpenGL together; this build has "
+#if DEFORMLAB_HAVE_CUDA
+      "no OpenGL (configure with OpenGL, EGL and GLEW found)");
+#elif DEFORMLAB_HAVE_GL
+      "no CUDA (configure with a CUDA compiler found)");
+#else
+      "neither CUDA nor OpenGL");
+#endif
+#endif
+}
+
+int calibrate_command(const CalibrateArgs& a) {
   return report_errors([&] {
-    nlohmann::json j = interop::calibrate({}, std::cerr);
-    j["command"] = a.argv;
-    j["build"] = build_info();
-    j["machine"] = machine_info();
+    const nlohmann::json j = measure_calibration(a.argv);
     if (a.out) {
       write_json(*a.out, j);
       std::cerr << "  wrote " << *a.out << "\n";
@@ -24,18 +42,6 @@ int calibrate_command(const CalibrateArgs& a) {
     }
     return 0;
   });
-#else
-  (void)a;
-  std::cerr << "deformlab: error: calibrate measures CUDA and OpenGL together; this build has "
-#if DEFORMLAB_HAVE_CUDA
-               "no OpenGL (configure with OpenGL, EGL and GLEW found)\n";
-#elif DEFORMLAB_HAVE_GL
-               "no CUDA (configure with a CUDA compiler found)\n";
-#else
-               "neither CUDA nor OpenGL\n";
-#endif
-  return 2;
-#endif
 }
 
 }  // namespace deformlab::app

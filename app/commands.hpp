@@ -2,6 +2,7 @@
 // failed (divergence, a backend error), 2 bad input (nothing written).
 #pragma once
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,7 @@ struct ExperimentArgs {
   std::optional<std::string> out;
   bool report_only = false;
   std::optional<int> max_size;  // leave out sizes above this (a later run can add them)
+  std::optional<std::string> calibration;  // a `deformlab calibrate` JSON for the manifest
 };
 
 // Runs `body`, turning an exception into one line on stderr and an exit code: 2 for
@@ -42,5 +44,9 @@ int run_command(const RunArgs& a);
 int experiment_command(const ExperimentArgs& a);
 int list_command();
 int calibrate_command(const CalibrateArgs& a);
+
+// This device's calibration (interop/calibrate.hpp) with the build, machine and `argv`;
+// throws std::invalid_argument where it cannot be measured (no CUDA, no GL, ...).
+nlohmann::json measure_calibration(const std::vector<std::string>& argv);
 
 }  // namespace deformlab::app

@@ -1,14 +1,27 @@
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
+#include "experiments/ceilings.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
 
 namespace deformlab::app {
+
+namespace {
+
+bool has_calibration(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "manifest.json");
+  if (!in) return false;
+  const nlohmann::json m = nlohmann::json::parse(in, nullptr, false);
+  return m.is_object() && m.contains("calibration") && m["calibration"].is_object();
+}
+
+}  // namespace
 
 int experiment_command(const ExperimentArgs& a) {
   Experiment x;
@@ -26,11 +39,36 @@ int experiment_command(const ExperimentArgs& a) {
     return 2;
   }
   const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
+  nlohmann::json calibration;
+  try {
+    if (a.calibration) calibration = read_calibration(*a.calibration);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "deformlab: error: " << e.what() << "\n";
+    return 2;
+  }
   return report_errors([&] {
+    if (a.report_only && !calibration.is_null()) {
+      // Records the calibration given in the folder's manifest; the cells stay as they are.
+      std::ifstream in(dir / "manifest.json");
+      if (!in) throw std::invalid_argument("no manifest.json in " + dir.string());
+      nlohmann::json manifest = nlohmann::json::parse(in);
+      manifest["calibration"] = calibration;
+      write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
+    }
     if (!a.report_only) {
+      if (calibration.is_null() && !has_calibration(dir)) {
+        // Measured once per results folder, where this machine can (CUDA and GL together).
+        try {
+          std::cout << "calibrating this device (`deformlab calibrate`)" << std::endl;
+          calibration = measure_calibration(a.argv);
+        } catch (const std::invalid_argument& e) {
+          std::cout << "no calibration: " << e.what() << "\n";
+        }
+      }
       std::cout << "deformlab experiment " << x.name << ": " << cells(*sweep).size() << " cells into "
                 << dir.string() << " (cells already there are kept)\n";
       SweepOptions o;
+      o.calibration = calibration;
       o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
         const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0;

@@ -55,6 +55,10 @@ int main(int argc, char** argv) {
   experiment->add_option("--max-size", ex.max_size, "Leave out grid sizes above this for now (cells resume later)")
       ->check(CLI::PositiveNumber);
   experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
+  experiment->add_option("--calibration", ex.calibration,
+                         "Calibration JSON (from `deformlab calibrate --out`) to record in the manifest and show "
+                         "stages against (default: the folder's, else measured now where CUDA and OpenGL are both "
+                         "available)");
 
   auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");
 

@@ -1,5 +1,6 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -8,6 +9,8 @@
 #include <set>
 #include <sstream>
 
+#include "ceilings.hpp"
+#include "core/profiler.hpp"
 #include "paper.hpp"
 #include "plot.hpp"
 #include "sweep.hpp"
@@ -27,6 +30,14 @@ std::string fmt(double v) {
   return os.str();
 }
 
+std::string percent(double v) {
+  std::ostringstream os;
+  if (v >= 10) os << std::lround(v);
+  else if (v >= 1) os << std::fixed << std::setprecision(1) << v;
+  else os << std::setprecision(2) << v;
+  return os.str() + "%";
+}
+
 std::string options_label(const json& o) {
   std::string s;
   for (const auto& [k, v] : o.items()) s += (s.empty() ? "" : ", ") + k + "=" + v.get<std::string>();
@@ -43,6 +54,155 @@ struct Table {
   std::string title;
   std::vector<Column> columns;
 };
+
+// Each measured step as a fraction of its ceiling (ceilings.hpp): ceiling / measured.
+template <class Ours>
+void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& columns, const std::set<int>& sizes,
+                         const Ceilings& ceil, const Ours& ours) {
+  std::vector<const Column*> cols;
+  std::vector<std::pair<std::string, std::vector<std::string>>> bounds;  // what bounds which columns
+  for (const auto& c : columns) {
+    const auto b = stage_ceiling(ceil, c.pipeline, "step", 1, *parse_integrator(c.integrator));
+    const bool measured = std::any_of(sizes.begin(), sizes.end(),
+                                      [&](int n) { return ours(c.pipeline, c.integrator, c.options, n) != nullptr; });
+    if (!b || !measured) continue;
+    cols.push_back(&c);
+    auto it = std::find_if(bounds.begin(), bounds.end(), [&](const auto& e) { return e.first == b->what; });
+    if (it == bounds.end()) bounds.push_back({b->what, {c.label}});
+    else it->second.push_back(c.label);
+  }
+  if (cols.empty()) return;
+  md << "Against this device's ceilings: the least time a step could take (ms) and the measured step's fraction "
+        "of it (ceiling / measured; 100% = at the ceiling).\n\n| grid |";
+  for (const Column* c : cols) md << " " << c->label << " |";
+  md << "\n|---|";
+  for (std::size_t k = 0; k < cols.size(); ++k) md << "---|";
+  md << "\n";
+  for (int n : sizes) {
+    md << "| " << n << "² |";
+    for (const Column* c : cols) {
+      const json* r = ours(c->pipeline, c->integrator, c->options, n);
+      if (!r) {
+        md << " - |";
+        continue;
+      }
+      const auto b = stage_ceiling(ceil, c->pipeline, "step", (*r)["nodes"].get<std::int64_t>(),
+                                   *parse_integrator(c->integrator));
+      md << " " << fmt(b->ms) << " (" << percent(100 * b->ms / (*r)["median_ms"].get<double>()) << ") |";
+    }
+    md << "\n";
+  }
+  md << "\nCeilings:";
+  for (const auto& [what, labels] : bounds) {
+    md << "\n- ";
+    for (std::size_t k = 0; k < labels.size(); ++k) md << (k ? ", " : "") << labels[k];
+    md << ": " << what;
+  }
+  md << "\n\n";
+}
+
+// Cells that timed their stages (a profiled batch apart from the timed ones): each stage's
+// GPU time per step and its fraction of its ceiling, what the GPU stages leave of the
+// step (hand-offs, waits, launches), and for the hybrids the time per hand-off against the
+// floor; stacked bars of each pipeline's split by size.
+void write_stages(std::ostringstream& md, const fs::path& dir, const std::string& name, const Sweep& sweep,
+                  const std::vector<json>& cells, const Ceilings& ceil) {
+  struct Group {
+    std::string label, pipeline, integrator;
+    std::vector<const json*> rows;
+    std::vector<std::string> gpu_stages, host_stages;
+  };
+  std::vector<Group> groups;
+  for (const auto& c : deformlab::cells(sweep)) {
+    std::string label = c.pipeline + " " + c.integrator;
+    if (!c.options.empty()) label += " [" + options_label(json(c.options)) + "]";
+    Group g{label, c.pipeline, c.integrator, {}, {}, {}};
+    bool seen = false;
+    for (const auto& e : groups) seen |= e.label == label;
+    if (seen) continue;
+    for (const auto& r : cells)
+      if (r["status"] == "ok" && r.contains("stages") && r["pipeline"] == c.pipeline &&
+          r["integrator"] == c.integrator && r["options"] == json(c.options))
+        g.rows.push_back(&r);
+    if (g.rows.empty()) continue;
+    std::sort(g.rows.begin(), g.rows.end(),
+              [](const json* a, const json* b) { return (*a)["size"].get<int>() < (*b)["size"].get<int>(); });
+    for (const json* r : g.rows)
+      for (const auto& st : (*r)["stages"]) {
+        auto& list = st["clock"] == "host clock" ? g.host_stages : g.gpu_stages;
+        if (std::find(list.begin(), list.end(), st["name"]) == list.end()) list.push_back(st["name"]);
+      }
+    groups.push_back(std::move(g));
+  }
+  if (groups.empty()) return;
+  md << "## Where a step's time goes\n\n"
+        "Stage times are medians per step over one more batch run with the profiler attached, each by its own "
+        "clock (CUDA events, GL timer queries); \"rest\" is the timed step less its GPU stages: hand-offs, "
+        "waits and launch gaps. Host-clock columns are CPU time inside those calls.";
+  if (ceil.any()) md << " In brackets: the stage's ceiling / its time (ceilings.hpp; 100% = at the ceiling).";
+  md << "\n\n";
+  for (const Group& g : groups) {
+    const Integrator integ = *parse_integrator(g.integrator);
+    const bool hybrid = g.pipeline.rfind("hybrid", 0) == 0;
+    const double hand_offs = 2.0 * info(integ).force_passes;
+    md << "### " << g.label << "\n\n| grid | step ms |";
+    for (const auto& st : g.gpu_stages) md << " " << st << " ms |";
+    md << " rest ms |";
+    for (const auto& st : g.host_stages) md << " " << st << " (CPU) ms |";
+    if (hybrid) md << " rest per hand-off µs |" << (ceil.floor_us > 0 ? " x floor |" : "");
+    md << "\n|---|---|";
+    const std::size_t ncols = g.gpu_stages.size() + 1 + g.host_stages.size() + (hybrid ? (ceil.floor_us > 0 ? 2 : 1) : 0);
+    for (std::size_t k = 0; k < ncols; ++k) md << "---|";
+    md << "\n";
+    std::vector<plot::Stack> bars;
+    for (const json* r : g.rows) {
+      const double step = (*r)["median_ms"].get<double>();
+      const std::int64_t nodes = (*r)["nodes"].get<std::int64_t>();
+      auto stage_ms = [&](const std::string& st) -> std::optional<double> {
+        for (const auto& e : (*r)["stages"])
+          if (e["name"] == st) return e["median_ms"].get<double>();
+        return std::nullopt;
+      };
+      md << "| " << (*r)["size"].get<int>() << "² | " << fmt(step) << " |";
+      plot::Stack bar{std::to_string((*r)["size"].get<int>()) + "² " + fmt(step) + " ms", {}};
+      double gpu = 0;
+      for (const auto& st : g.gpu_stages) {
+        const auto v = stage_ms(st);
+        if (!v) {
+          md << " - |";
+          bar.parts.push_back(0);
+          continue;
+        }
+        gpu += *v;
+        md << " " << fmt(*v);
+        if (const auto b = stage_ceiling(ceil, g.pipeline, st, nodes, integ)) md << " (" << percent(100 * b->ms / *v) << ")";
+        md << " |";
+        bar.parts.push_back(100 * *v / step);
+      }
+      const double rest = std::max(0.0, step - gpu);
+      md << " " << fmt(rest) << " |";
+      bar.parts.push_back(100 * rest / step);
+      for (const auto& st : g.host_stages) {
+        const auto v = stage_ms(st);
+        md << " " << (v ? fmt(*v) : "-") << " |";
+      }
+      if (hybrid) {
+        const double per = rest / hand_offs * 1e3;
+        md << " " << fmt(per) << " |";
+        if (ceil.floor_us > 0) md << " " << fmt(per / ceil.floor_us) << " |";
+      }
+      md << "\n";
+      bars.push_back(std::move(bar));
+    }
+    std::vector<std::string> parts = g.gpu_stages;
+    parts.push_back("rest");
+    std::string file = "stages-" + g.label + ".svg";
+    for (char& ch : file)
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '.') ch = '_';
+    plot::stacked_bars(dir / file, name + ": " + g.label, "% of the step", parts, bars);
+    md << "\n![" << g.label << " stages](" << file << ")\n\n";
+  }
+}
 
 }  // namespace
 
@@ -94,6 +254,16 @@ fs::path write_report(const fs::path& dir) {
   md << "- Build: deformlab " << manifest["build"].value("deformlab", std::string()) << " ("
      << manifest["build"].value("git", std::string()) << "), " << manifest["build"].value("compiler", std::string())
      << ", CUDA " << manifest["build"].value("cuda", std::string()) << "\n";
+  const json calibration = manifest.value("calibration", json());
+  const Ceilings ceil = ceilings_of(calibration);
+  if (ceil.any()) {
+    md << "- Calibration (`deformlab calibrate`, " << calibration.value("device", json::object()).value("name", std::string("?"))
+       << "): CUDA copy " << fmt(ceil.copy_gb_s) << " GB/s, compute-shader copy " << fmt(ceil.compute_copy_gb_s)
+       << " GB/s, transform feedback " << fmt(ceil.tf_vertices_s * 1e-6) << " M vertices/s, GL <-> CUDA hand-off floor "
+       << fmt(ceil.floor_us) << " µs\n";
+  } else {
+    md << "- No calibration recorded: times are not shown against ceilings\n";
+  }
   for (const auto& [p, status] : manifest["pipelines"].items())
     if (status != "available") md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
   md << "- Method: ";
@@ -201,7 +371,9 @@ fs::path write_report(const fs::path& dir) {
     const std::string svg = "plot-" + t.title + ".svg";
     plot::loglog(dir / svg, name + ": " + t.title, "nodes", "ms per step (dashed: paper, ms per frame)", series);
     md << "\n![" << t.title << "](" << svg << ")\n\n";
+    if (ceil.any() && sweep.time == "update") write_ceiling_table(md, t.columns, sizes, ceil, ours);
   }
+  write_stages(md, dir, name, sweep, cells, ceil);
   if (!notes.empty()) {
     md << "## Notes on cells\n\n";
     for (std::size_t k = 0; k < notes.size(); ++k) {

@@ -208,6 +208,23 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
       ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
     }
     const double d = pipe->max_displacement();
+    // One more batch with a profiler attached, for each stage's time per step; it is kept
+    // out of the timed batches (a profiled CUDA pipeline runs pass by pass, not as a graph).
+    Profiler prof;
+    pipe->set_profiler(&prof);
+    for (int st = 1; st <= s.steps; ++st) {
+      prof.set_step(st);
+      step();
+    }
+    finish();
+    pipe->set_profiler(nullptr);
+    json stages = json::array();
+    for (const auto& g : prof.summary())
+      stages.push_back({{"name", g.name},
+                        {"median_ms", g.median_ms},
+                        {"clock", g.clock},
+                        {"per_step", double(g.spans) / g.steps}});
+    if (!stages.empty()) r["stages"] = stages;
     r["status"] = "ok";
     r["median_ms"] = median_of(ms_per_step);
     r["min_ms"] = *std::min_element(ms_per_step.begin(), ms_per_step.end());
@@ -256,6 +273,13 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   using clock = std::chrono::steady_clock;
   fs::create_directories(dir / "cells");
   json manifest = {{"experiment", x.raw}, {"command", command}, {"build", build_info()}, {"machine", machine_info()}};
+  // The calibration given, else the one an earlier run of this folder recorded.
+  manifest["calibration"] = o.calibration;
+  if (o.calibration.is_null() && fs::exists(dir / "manifest.json")) {
+    std::ifstream in(dir / "manifest.json");
+    const json old = json::parse(in, nullptr, false);
+    if (old.is_object() && old.contains("calibration")) manifest["calibration"] = old["calibration"];
+  }
   json devices = json::object();
   for (const auto& p : s.pipelines)
     if (const auto* e = pipelines().find(p)) devices[p] = e->unavailable().empty() ? "available" : e->unavailable();

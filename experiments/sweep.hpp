@@ -46,11 +46,13 @@ struct SweepProgress {
 
 struct SweepOptions {
   std::function<void(const Cell&, const nlohmann::json& result, const SweepProgress&)> on_cell;
+  // This device's ceilings (`deformlab calibrate`'s JSON) for the manifest and the report;
+  // null keeps the calibration the folder's manifest already has.
+  nlohmann::json calibration;
 };
 
 // Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again) and returns
-// the number it ran. Writes
-// `dir`/manifest.json (experiment, build, machine) first.
+// the number it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first.
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
 
@@ -60,7 +62,8 @@ struct ModelCache {
   std::unique_ptr<Model> model;
 };
 
-// One cell's result: {"status": "ok", "median_ms", ...} or {"status": "n/a", "reason"}.
+// One cell's result: {"status": "ok", "median_ms", ..., "stages": [{"name", "median_ms",
+// "clock", "per_step"}] for pipelines that time their stages} or {"status": "n/a", "reason"}.
 nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
 
 // Reads every cell result in `dir`/cells/.

@@ -130,6 +130,10 @@ TEST_F(Cli, BadInputsAreRefused) {
   expect_refused("run --pipeline cpu --integrator rk4 --grid 4x4 --scene " +
                      write("drag.json", "{\"drag\": {\"node\": 99, \"path\": [[0, 0, 0, 0]]}}").string(),
                  "drag node 99 is outside the model");
+  expect_refused("experiment quick --calibration " + (dir_ / "none.json").string(), "cannot read the calibration file");
+  expect_refused("experiment quick --calibration " + write("cal.json", "[1, 2]").string(), "not a JSON object");
+  expect_refused("experiment quick --calibration " + write("cal2.json", "{\"copy\": {\"GB_per_s\": 0}}").string(),
+                 "no ceilings in it");
 }
 
 TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {

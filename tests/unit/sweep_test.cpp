@@ -54,6 +54,20 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
       EXPECT_GT(r["median_ms"].get<double>(), 0.0);
       EXPECT_EQ(r["samples_ms"].size(), 3u);
       EXPECT_EQ(r["integrator"], "midpoint");
+      // GPU pipelines time their stages in a profiled batch (midpoint: two passes a step);
+      // the CPU ones have no stages.
+      if (r["pipeline"] == "cuda-naive") {
+        ASSERT_EQ(r["stages"].size(), 2u) << r.dump();
+        EXPECT_EQ(r["stages"][0]["name"], "force");
+        EXPECT_EQ(r["stages"][0]["per_step"], 2.0);
+        EXPECT_EQ(r["stages"][1]["name"], "update");
+      } else if (r["pipeline"] == "glsl-tf") {
+        ASSERT_EQ(r["stages"].size(), 1u) << r.dump();
+        EXPECT_EQ(r["stages"][0]["name"], "force+update");
+        EXPECT_GT(r["stages"][0]["median_ms"].get<double>(), 0.0);
+      } else {
+        EXPECT_FALSE(r.contains("stages")) << r.dump();
+      }
     } else {
       EXPECT_EQ(r["status"], "n/a");
       EXPECT_EQ(r["reason"], e.unavailable());
@@ -154,6 +168,63 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
   const std::string svg = slurp(dir_ / "plot-explicit-euler.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("paper (d) TF"), std::string::npos);
+}
+
+// With a calibration in the manifest, each step is shown against its ceiling and each timed
+// stage against its own; a hybrid's time left after its GPU stages is split per hand-off and
+// set against the floor; its split is drawn as stacked bars. Figures (ceilings.hpp), 64²
+// = 4096 nodes, semi-implicit Euler (one force evaluation), copy 1000 GB/s, TF 1e8
+// vertices/s, floor 100 µs: cuda-fused step 64 B x 4096 / 1e12 B/s = 0.000262 ms, 2.6% of
+// its 0.01 ms; hybrid force 48 B x 4096 -> 0.000197 ms (2.0% of 0.01), update 4096 / 1e8 s
+// = 0.04096 ms (41% of 0.1), step ceiling 0.000197 + 0.04096 + 2 x 0.1 = 0.241 ms (48% of
+// 0.5); rest 0.5 - 0.01 - 0.1 = 0.39 ms over 2 hand-offs = 195 µs, 1.95 x the floor.
+TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
+  fs::create_directories(dir_ / "cells");
+  const json experiment = json::parse(R"({"name": "lab", "integrator": "semi-implicit-euler",
+      "sweep": {"sizes": [64], "pipelines": ["cuda-fused", "hybrid"], "options": [{"interop": "map"}]}})");
+  const json calibration = {{"device", {{"name", "test gpu"}}},
+                            {"copy", {{"GB_per_s", 1000.0}}},
+                            {"compute_copy", {{"GB_per_s", 500.0}}},
+                            {"transform_feedback", {{"vertices_per_s", 1e8}}},
+                            {"floor", {{"us_per_hand_off", 100.0}}}};
+  json manifest = {{"experiment", experiment},
+                   {"build", {{"deformlab", "0"}, {"git", "g"}, {"compiler", "c"}, {"cuda", "13"}}},
+                   {"machine", {{"cpu", "test cpu"}, {"hardware_threads", 2}, {"os", "test os"}}},
+                   {"pipelines", {{"cuda-fused", "available"}, {"hybrid", "available"}}}};
+  std::ofstream(dir_ / "manifest.json") << manifest.dump();
+  auto cell = [&](const std::string& p, const json& options, double ms, const json& stages) {
+    json c = {{"id", p}, {"size", 64}, {"pipeline", p}, {"integrator", "semi-implicit-euler"}, {"options", options},
+              {"nodes", 4096}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"}, {"stages", stages}};
+    std::ofstream(dir_ / "cells" / (p + ".json")) << c.dump();
+  };
+  cell("cuda-fused", json::object(), 0.01,
+       json::array({{{"name", "force+update"}, {"median_ms", 0.008}, {"clock", "CUDA events"}, {"per_step", 1}}}));
+  cell("hybrid", {{"interop", "map"}}, 0.5,
+       json::array({{{"name", "force"}, {"median_ms", 0.01}, {"clock", "CUDA events"}, {"per_step", 1}},
+                    {{"name", "hand-off"}, {"median_ms", 0.005}, {"clock", "host clock"}, {"per_step", 2}},
+                    {{"name", "update"}, {"median_ms", 0.1}, {"clock", "GL timer queries"}, {"per_step", 1}}}));
+
+  std::string md = slurp(write_report(dir_));
+  EXPECT_NE(md.find("No calibration recorded"), std::string::npos) << md;
+  EXPECT_EQ(md.find("Against this device's ceilings"), std::string::npos) << md;
+
+  manifest["calibration"] = calibration;
+  std::ofstream(dir_ / "manifest.json") << manifest.dump();
+  md = slurp(write_report(dir_));
+  EXPECT_NE(md.find("Calibration (`deformlab calibrate`, test gpu): CUDA copy 1000.0 GB/s"), std::string::npos) << md;
+  EXPECT_NE(md.find("| grid | cuda-fused | hybrid [interop=map] |\n|---|---|---|\n| 64² | 0.000262 (2.6%) | 0.241 (48%) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| grid | step ms | force ms | update ms | rest ms | hand-off (CPU) ms | rest per hand-off µs | "
+                    "x floor |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 64² | 0.5 | 0.01 (2.0%) | 0.1 (41%) | 0.39 | 0.005 | 195.0 | 1.950 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 64² | 0.01 | 0.008 (3.3%) | 0.002 |"), std::string::npos) << md;
+  const std::string svg = slurp(dir_ / "stages-hybrid_semi-implicit-euler__interop_map_.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("rest"), std::string::npos);
+  EXPECT_NE(svg.find("64² 0.5 ms"), std::string::npos);
 }
 
 }  // namespace

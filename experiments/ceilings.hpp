@@ -1,0 +1,48 @@
+// This device's ceilings, from `deformlab calibrate`'s JSON, and the least time each stage
+// of a GPU pipeline could take on it, so that reports show measured times as fractions of
+// their own ceilings and hand-offs against the floor.
+//
+// Per force evaluation and node, the least a stage must do:
+//   CUDA and compute-shader passes move their state once at the calibrated copy bandwidth
+//   (CUDA: device-to-device copy; GL compute: compute-shader copy): a force pass reads x, v
+//   and writes a (48 B), an update reads x, v, a and writes x, v (80 B), a fused
+//   force+update pass reads and writes x, v (64 B). Neighbour reads are left out (caches
+//   serve them), so these bounds are optimistic.
+//   Transform feedback passes emit one vertex per node at the pass-through vertex rate.
+//   A hybrid step hands off twice per force evaluation, each at least the floor.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "core/integrator.hpp"
+
+namespace deformlab {
+
+struct Ceilings {
+  double copy_gb_s = 0;          // CUDA device-to-device copy, GB/s read + written
+  double compute_copy_gb_s = 0;  // GL compute-shader copy, GB/s read + written
+  double tf_vertices_s = 0;      // pass-through transform feedback, vertices/s
+  double floor_us = 0;           // GL <-> CUDA semaphore ping-pong with no work, µs per hand-off
+  bool any() const { return copy_gb_s > 0 || compute_copy_gb_s > 0 || tf_vertices_s > 0 || floor_us > 0; }
+};
+
+// Missing or non-positive entries stay 0 (no ceiling of that kind).
+Ceilings ceilings_of(const nlohmann::json& calibration);
+// Reads a calibration file; throws std::invalid_argument naming the file and the problem
+// when it is not JSON or has none of the ceilings above.
+nlohmann::json read_calibration(const std::filesystem::path& file);
+
+// The least time in ms per step of `stage` (a span name, or "step" for the whole step) of
+// `pipeline` on `nodes` nodes, and what bounds it; nullopt where none applies
+// (CPU pipelines, stages without a ceiling, an uncalibrated ceiling).
+struct Bound {
+  double ms;
+  std::string what;
+};
+std::optional<Bound> stage_ceiling(const Ceilings& c, const std::string& pipeline, const std::string& stage,
+                                   std::int64_t nodes, Integrator integrator);
+
+}  // namespace deformlab
