@@ -12,6 +12,17 @@ struct Stats {
 };
 Stats stats(std::vector<double> ms);
 
+// What the per-step benches (cpu, gl) take: sizes, warm-up and timed steps, integrator, CSV.
+struct StepOptions {
+  std::vector<int> sizes;
+  int warmup = 5, reps = 30;
+  std::string integrator = "semi-implicit-euler";
+  std::string csv;  // also write the rows here when set
+};
+// Adds `name` with StepOptions' flags (defaults from `defaults`); `run` runs it.
+void add_step_bench(CLI::App& app, const char* name, const char* description, const StepOptions& defaults,
+                    void (*run)(const StepOptions&));
+
 void add_cpu_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_CUDA
 void add_cuda_bench(CLI::App& app);

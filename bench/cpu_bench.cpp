@@ -13,13 +13,6 @@ namespace deformlab::bench {
 
 namespace {
 
-struct CpuOptions {
-  std::vector<int> sizes{64, 128, 256, 512};
-  int warmup = 5, reps = 30;
-  std::string integrator = "semi-implicit-euler";
-  std::string csv;
-};
-
 void time_steps(Pipeline& p, int reps, std::vector<double>& ms) {
   using clock = std::chrono::steady_clock;
   for (int r = 0; r < reps; ++r) {
@@ -29,7 +22,7 @@ void time_steps(Pipeline& p, int reps, std::vector<double>& ms) {
   }
 }
 
-void run_cpu(const CpuOptions& o) {
+void run_cpu(const StepOptions& o) {
   const auto integ = parse_integrator(o.integrator);
   if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
   std::cout << "deformlab-bench cpu: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
@@ -67,14 +60,11 @@ void run_cpu(const CpuOptions& o) {
 }  // namespace
 
 void add_cpu_bench(CLI::App& app) {
-  auto o = std::make_shared<CpuOptions>();
-  auto* c = app.add_subcommand("cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)");
-  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
-  c->add_option("--warmup", o->warmup, "Warm-up steps");
-  c->add_option("--reps", o->reps, "Timed steps");
-  c->add_option("--integrator", o->integrator, "Integrator");
-  c->add_option("--csv", o->csv, "Also write the results to this CSV file");
-  c->callback([o] { run_cpu(*o); });
+  StepOptions defaults;
+  defaults.sizes = {64, 128, 256, 512};
+  defaults.warmup = 5;
+  defaults.reps = 30;
+  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", defaults, run_cpu);
 }
 
 }  // namespace deformlab::bench

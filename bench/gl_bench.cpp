@@ -15,15 +15,8 @@ namespace deformlab::bench {
 
 namespace {
 
-struct GlOptions {
-  std::vector<int> sizes{256, 512, 1024, 2048};
-  int warmup = 10, reps = 50;
-  std::string integrator = "semi-implicit-euler";
-  std::string csv;
-};
-
 // GPU ms per step of a GL pipeline: its own per-step timer after the warm-up.
-Stats time_pipeline(Pipeline& p, const Model& m, const GlOptions& o) {
+Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   auto& g = dynamic_cast<gl::GlPipeline&>(p);
   p.set_state(rest_state(m));
   for (int k = 0; k < o.warmup; ++k) p.step();
@@ -36,7 +29,7 @@ Stats time_pipeline(Pipeline& p, const Model& m, const GlOptions& o) {
 
 // Two vec4 attributes copied by a vertex shader into two transform feedback buffers,
 // ping-pong, one vertex per node: the TF traffic of a glsl-tf step without its physics.
-Stats time_passthrough(int n, const GlOptions& o) {
+Stats time_passthrough(int n, const StepOptions& o) {
   using namespace gl;
   Program prog = make_program({{GL_VERTEX_SHADER, "passthrough.vert"}}, "", {"o0", "o1"});
   Buffer buf[2][2];
@@ -86,7 +79,7 @@ Stats time_passthrough(int n, const GlOptions& o) {
   return s;
 }
 
-void run_gl(const GlOptions& o) {
+void run_gl(const StepOptions& o) {
   const auto integ = parse_integrator(o.integrator);
   if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
   const gl::ContextInfo& ctx = gl::context();
@@ -139,14 +132,11 @@ void run_gl(const GlOptions& o) {
 }  // namespace
 
 void add_gl_bench(CLI::App& app) {
-  auto o = std::make_shared<GlOptions>();
-  auto* c = app.add_subcommand("gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling");
-  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
-  c->add_option("--warmup", o->warmup, "Warm-up steps");
-  c->add_option("--reps", o->reps, "Timed steps");
-  c->add_option("--integrator", o->integrator, "Integrator");
-  c->add_option("--csv", o->csv, "Also write the results to this CSV file");
-  c->callback([o] { run_gl(*o); });
+  StepOptions defaults;
+  defaults.sizes = {256, 512, 1024, 2048};
+  defaults.warmup = 10;
+  defaults.reps = 50;
+  add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling", defaults, run_gl);
 }
 
 }  // namespace deformlab::bench
