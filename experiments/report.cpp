@@ -374,6 +374,20 @@ fs::path write_report(const fs::path& dir) {
     if (ceil.any() && sweep.time == "update") write_ceiling_table(md, t.columns, sizes, ceil, ours);
   }
   write_stages(md, dir, name, sweep, cells, ceil);
+  if (const json frames = manifest.value("frames", json()); frames.is_object()) {
+    md << "## Frames of the drag\n\n";
+    if (frames.contains("files")) {
+      md << "The experiment's own scene (" << frames.value("nodes", 0) << " nodes) on `"
+         << frames.value("pipeline", std::string()) << "`, " << frames.value("integrator", std::string()) << ", a "
+         << frames.value("size", json::array({0, 0}))[0] << " x " << frames.value("size", json::array({0, 0}))[1]
+         << " frame every " << frames.value("every_steps", 0) << " steps of " << frames.value("steps", 0)
+         << "; the camera frames the rest pose.\n\n";
+      for (const auto& f : frames["files"]) md << "![" << f.get<std::string>() << "](" << f.get<std::string>() << ") ";
+      md << "\n\n";
+    } else {
+      md << "None: " << frames.value("unavailable", std::string("?")) << "\n\n";
+    }
+  }
   if (!notes.empty()) {
     md << "## Notes on cells\n\n";
     for (std::size_t k = 0; k < notes.size(); ++k) {

@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <fstream>
 #include <sstream>
 
+#include "core/run.hpp"
+#include "core/scene.hpp"
 #include "core/state.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
@@ -89,13 +92,17 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     } else if (k == "time") {
       if (v != "update" && v != "frame") bad(w + ".time", "expected \"update\" or \"frame\" (update + render)");
       s.time = v.get<std::string>();
+    } else if (k == "frames") {
+      if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > 100)
+        bad(w + ".frames", "expected a number of frames from 0 to 100");
+      s.frames = v.get<int>();
     } else if (k == "paper_table") {
       if (v != "table1" && v != "table2" && v != "table3" && v != "")
         bad(w + ".paper_table", "expected \"table1\", \"table2\" or \"table3\"");
       s.paper_table = v.get<std::string>();
     } else
       bad(w + "." + k, "unknown key (expected sizes, pipelines, integrators, options, warmup, steps, "
-                       "repetitions, cell_limit_s, time, paper_table)");
+                       "repetitions, cell_limit_s, time, frames, paper_table)");
   }
   if (s.sizes.empty()) bad(w, "needs sizes");
   if (s.pipelines.empty()) bad(w, "needs pipelines");
@@ -245,6 +252,51 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
   }
 }
 
+json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
+#if DEFORMLAB_HAVE_GL
+  if (auto why = gl::unavailable_reason(); !why.empty()) return {{"unavailable", "no OpenGL: " + why}};
+  const fs::path tmp = dir / ("frames.tmp-" + std::to_string(::getpid()));
+  try {
+    const Model m = build_model(x.scene);
+    Params p = resolve_params(x.scene, m);
+    const Integrator integ = *parse_integrator(x.integrator);
+    const PipelineEntry& e = best_pipeline(integ);
+    const int span = std::max(p.min_steps, int(std::ceil(1.25 * p.drag.end_time() / p.dt)));
+    const int every = std::max(1, (span + s.frames - 1) / s.frames);
+    p.max_steps = std::min(every * s.frames, p.max_steps);  // the last frame is the last step
+    auto pipe = e.make({m, p, integ, {}});
+    pipe->set_state(rest_state(m));
+    fs::remove_all(tmp);
+    gl::FrameWriter frames(m, tmp, every, {512, 512});
+    RunOptions opt;
+    opt.after_step = [&](int step) { frames.after_step(*pipe, step); };
+    const RunResult r = run(*pipe, m, p, opt);
+    frames.finish(*pipe, r.steps);
+    fs::rename(tmp, dir / "frames");
+    std::vector<std::string> files;
+    for (const auto& f : fs::directory_iterator(dir / "frames"))
+      if (f.path().extension() == ".png") files.push_back("frames/" + f.path().filename().string());
+    std::sort(files.begin(), files.end());
+    json j = frames.manifest();
+    j["pipeline"] = e.name;
+    j["integrator"] = x.integrator;
+    j["nodes"] = m.node_count();
+    j["steps"] = r.steps;
+    j["dt_s"] = p.dt;
+    j["files"] = files;
+    return j;
+  } catch (const std::exception& ex) {
+    fs::remove_all(tmp);
+    return {{"unavailable", std::string("rendering failed: ") + ex.what()}};
+  }
+#else
+  (void)x;
+  (void)s;
+  (void)dir;
+  return {{"unavailable", "this build has no OpenGL"}};
+#endif
+}
+
 void write_atomically(const fs::path& file, const std::string& text) {
   const fs::path tmp = file.string() + ".tmp-" + std::to_string(::getpid());
   {
@@ -273,12 +325,15 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   using clock = std::chrono::steady_clock;
   fs::create_directories(dir / "cells");
   json manifest = {{"experiment", x.raw}, {"command", command}, {"build", build_info()}, {"machine", machine_info()}};
-  // The calibration given, else the one an earlier run of this folder recorded.
+  // The calibration given, else the one an earlier run of this folder recorded; the frames
+  // an earlier run rendered.
   manifest["calibration"] = o.calibration;
-  if (o.calibration.is_null() && fs::exists(dir / "manifest.json")) {
+  if (fs::exists(dir / "manifest.json")) {
     std::ifstream in(dir / "manifest.json");
     const json old = json::parse(in, nullptr, false);
-    if (old.is_object() && old.contains("calibration")) manifest["calibration"] = old["calibration"];
+    if (old.is_object() && old.contains("calibration") && o.calibration.is_null())
+      manifest["calibration"] = old["calibration"];
+    if (old.is_object() && old.contains("frames") && fs::exists(dir / "frames")) manifest["frames"] = old["frames"];
   }
   json devices = json::object();
   for (const auto& p : s.pipelines)
@@ -310,6 +365,10 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     ++prog.done;
     prog.elapsed_s = std::chrono::duration<double>(clock::now() - start).count();
     if (o.on_cell) o.on_cell(c, r, prog);
+  }
+  if (s.frames > 0 && !fs::exists(dir / "frames")) {
+    manifest["frames"] = render_frames(x, s, dir);
+    write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
   }
   return ran;
 }

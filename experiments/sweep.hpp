@@ -27,6 +27,7 @@ struct Sweep {
   double cell_limit_s = 120;                  // a cell expected to take longer is cut (n/a)
   std::string time = "update";                // "update", or "frame": update + render
   std::string paper_table;                    // "table1", "table2", "table3" or "" (report)
+  int frames = 4;                             // frames of the experiment's scene for the report (0: none)
 };
 
 struct Cell {
@@ -52,7 +53,9 @@ struct SweepOptions {
 };
 
 // Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again) and returns
-// the number it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first.
+// the number it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first;
+// then, unless `dir`/frames/ exists, renders the sweep's frames there (render_frames) and
+// records them, or why there are none, as the manifest's "frames".
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
 
@@ -65,6 +68,12 @@ struct ModelCache {
 // One cell's result: {"status": "ok", "median_ms", ..., "stages": [{"name", "median_ms",
 // "clock", "per_step"}] for pipelines that time their stages} or {"status": "n/a", "reason"}.
 nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
+
+// Frames of the experiment's own scene (its model, not a sweep size) on the best pipeline
+// here, `s.frames` of them spread over the drag (or min_steps), drawn at 512 x 512 into
+// `dir`/frames/ (written to a temporary folder, then renamed). Returns what was rendered,
+// or {"unavailable": why} (no OpenGL, a run that failed).
+nlohmann::json render_frames(const Experiment& x, const Sweep& s, const std::filesystem::path& dir);
 
 // Reads every cell result in `dir`/cells/.
 std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);

@@ -85,6 +85,17 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   EXPECT_EQ(seen_skipped, 7 - na);
   for (const auto& f : fs::recursive_directory_iterator(dir_))
     EXPECT_EQ(f.path().string().find(".tmp-"), std::string::npos) << f.path();
+  // Frames of the drag for the report: rendered once (kept on resume), or the reason why not.
+  std::ifstream in(dir_ / "manifest.json");
+  const json manifest = json::parse(in);
+  ASSERT_TRUE(manifest.contains("frames")) << manifest.dump();
+  if (manifest["frames"].contains("files")) {
+    EXPECT_EQ(manifest["frames"]["files"].size(), 4u) << manifest["frames"].dump();
+    for (const auto& f : manifest["frames"]["files"]) EXPECT_TRUE(fs::exists(dir_ / f.get<std::string>())) << f;
+    EXPECT_NE(slurp(write_report(dir_)).find("## Frames of the drag"), std::string::npos);
+  } else {
+    EXPECT_NE(manifest["frames"]["unavailable"].get<std::string>().find("OpenGL"), std::string::npos);
+  }
 }
 
 TEST_F(SweepTest, SlowCellsAreCutWithTheReason) {
