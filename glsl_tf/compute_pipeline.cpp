@@ -3,6 +3,12 @@
 #include "pipelines_internal.hpp"
 
 namespace deformlab::gl {
+
+std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t max_x) {
+  const std::int64_t y = (groups + max_x - 1) / max_x, x = (groups + y - 1) / y;
+  return {std::uint32_t(x), std::uint32_t(y)};
+}
+
 namespace {
 
 class ComputePipeline final : public GlPipeline {
@@ -14,6 +20,13 @@ class ComputePipeline final : public GlPipeline {
     const int need = forces ? 12 : 11;
     if (blocks < need)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
+    GLint max_x = 0, max_y = 0;
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_x);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &max_y);
+    groups_ = dispatch_shape((std::int64_t(n_) + 255) / 256, max_x);
+    if (groups_[1] > std::uint32_t(max_y))
+      throw std::invalid_argument(name_ + ": " + std::to_string(n_) + " nodes need more work groups than this driver's " +
+                                  std::to_string(max_x) + " x " + std::to_string(max_y));
     init();
   }
 
@@ -28,10 +41,12 @@ class ComputePipeline final : public GlPipeline {
     for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7 + k, io.out[k]->id());
     if (io.forces_acc) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, io.forces_acc->id());
     glUseProgram(program);
-    glDispatchCompute(GLuint((n_ + 255) / 256), 1, 1);
+    glDispatchCompute(groups_[0], groups_[1], 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(0);
   }
+
+  std::array<std::uint32_t, 2> groups_{};  // work groups of 256 nodes, x by y (step.comp)
 };
 
 }  // namespace

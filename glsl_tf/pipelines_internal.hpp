@@ -1,5 +1,7 @@
 // The GL pipelines' factories (registered by pipelines.cpp, used directly by tests and bench).
 #pragma once
+#include <array>
+#include <cstdint>
 #include <memory>
 
 #include "core/pipeline.hpp"
@@ -13,5 +15,9 @@ std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s);
 // forces (the update passes of the hybrid pipelines).
 std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, ExternalForces* forces);
 std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, ExternalForces* forces);
+
+// The compute passes' dispatch: `groups` work groups as x by y, x at most `max_x` (a driver
+// may allow only the spec's 65535), y as small as possible, x * y - groups < y.
+std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t max_x);
 
 }  // namespace deformlab::gl

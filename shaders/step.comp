@@ -26,7 +26,8 @@ vec4 forces_acc(int i) { return forces_acc_[i]; }
 #include "sim.glsl"
 
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
+  int i = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
   if (i >= dims.w) return;
 #if PASS == PASS_VERLET
   vec4 xp = s0_p[i];
