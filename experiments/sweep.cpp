@@ -249,6 +249,8 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
     return na(ex.what());
   } catch (const std::bad_alloc&) {
     return na("does not fit: out of host memory");
+  } catch (const std::exception& ex) {  // a pipeline failed (a driver error, a divergence)
+    return na(std::string("failed: ") + ex.what());
   }
 }
 
@@ -261,9 +263,9 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
     Params p = resolve_params(x.scene, m);
     const Integrator integ = *parse_integrator(x.integrator);
     const PipelineEntry& e = best_pipeline(integ);
-    const int span = std::max(p.min_steps, int(std::ceil(1.25 * p.drag.end_time() / p.dt)));
-    const int every = std::max(1, (span + s.frames - 1) / s.frames);
-    p.max_steps = std::min(every * s.frames, p.max_steps);  // the last frame is the last step
+    const int span = std::min(p.max_steps, std::max(p.min_steps, int(std::ceil(1.25 * p.drag.end_time() / p.dt))));
+    const int every = std::max(1, span / s.frames);
+    p.max_steps = every * s.frames;  // the last frame is the last step
     auto pipe = e.make({m, p, integ, {}});
     pipe->set_state(rest_state(m));
     fs::remove_all(tmp);
