@@ -41,12 +41,6 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
   return out;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 // Largest |x - x_ref| over nodes, relative to the reference state's bounding-box diagonal.
 double relative_position_error(const State& s, const State& ref) {
   double err = 0.0;

@@ -15,16 +15,21 @@ namespace deformlab::bench {
 
 namespace {
 
-// GPU ms per step of a GL pipeline: its own per-step timer after the warm-up.
+// GPU ms per step of a GL pipeline: its profiled force+update span of each step after the warm-up.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
-  auto& g = dynamic_cast<gl::GlPipeline&>(p);
   p.set_state(rest_state(m));
   for (int k = 0; k < o.warmup; ++k) p.step();
-  g.take_step_ms();
-  for (int k = 0; k < o.reps; ++k) p.step();
-  const Stats s = stats(g.take_step_ms());
+  Profiler prof;
+  p.set_profiler(&prof);
+  for (int k = 1; k <= o.reps; ++k) {
+    prof.set_step(k);
+    p.step();
+  }
+  p.set_profiler(nullptr);
+  std::vector<double> ms;
+  for (const Span& sp : prof.spans()) ms.push_back(sp.ms);
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
-  return s;
+  return stats(ms);
 }
 
 // Two vec4 attributes copied by a vertex shader into two transform feedback buffers,

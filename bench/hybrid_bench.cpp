@@ -141,11 +141,12 @@ void run_hybrid(const HybridOptions& o) {
       auto p = gl::make_tf_update(setup, nullptr);
       p->set_state(rest_state(m));
       for (int s = 0; s < o.warmup; ++s) p->step();
-      p->take_step_ms();
       Row r{n, "glsl-tf", "-"};
-      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
-      std::vector<double> gpu = p->take_step_ms();
-      r.gpu_ms = stats(gpu).median;
+      Profiler prof;
+      p->set_profiler(&prof);
+      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, &prof);
+      p->set_profiler(nullptr);
+      r.gpu_ms = stage_ms(prof, span::force_update);
       print(r);
     }
     for (const auto& u : o.updates)

@@ -13,6 +13,12 @@
 
 namespace deformlab {
 
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 Profiler::Profiler() : t0_(std::chrono::steady_clock::now()) {}
 
 double Profiler::now_ms() const {
@@ -40,8 +46,7 @@ std::vector<Profiler::Stage> Profiler::summary() const {
     std::vector<double> v;
     for (const auto& [step, ms] : per_step[g.name]) v.push_back(ms);
     g.steps = int(v.size());
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    g.median_ms = v[v.size() / 2];
+    g.median_ms = median(std::move(v));
   }
   return out;
 }

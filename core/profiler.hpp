@@ -24,6 +24,9 @@ inline constexpr const char* reductions = "reductions";
 inline constexpr const char* render = "render";
 }  // namespace span
 
+// The median of timings (the upper one of an even count); 0 for none.
+double median(std::vector<double> v);
+
 struct Span {
   std::string name;
   int step = 0;           // the step the span belongs to (0: before the first step)

@@ -5,7 +5,6 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
-#include <utility>
 
 namespace deformlab::gl {
 namespace {
@@ -86,7 +85,6 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces*
   if (adjacency > max_texels || n_ + 1 > max_texels)
     throw std::invalid_argument(name_ + ": the model needs texture buffers larger than this driver's " +
                                 std::to_string(max_texels) + " texels");
-  timer_ = std::make_unique<Timer>();
 
   const std::size_t bytes = std::size_t(n_) * 16;
   // The states forces are evaluated at (and the accelerations) belong to the external
@@ -307,17 +305,15 @@ State GlPipeline::state() {
 }
 
 void GlPipeline::step() {
-  context();
+  const bool debug = context().debug;
   const int c = cur_, d = 1 - cur_;
   const double dt = p_.dt;
   const Vec3f next = p_.drag.active() ? p_.drag.target(t_ + dt) : Vec3f{};
   // With an external force stage, it times the passes (GL timer spans may not nest).
-  if (!forces_) {
-    if (prof_) {
-      if (profiled_.size() >= 512) collect_steps();
-      profiled_.push_back({prof_->step(), prof_->now_ms()});
-    }
-    timer_->begin();
+  const bool timed = prof_ && !forces_;
+  if (timed) {
+    if (spans_.pending() >= 512) spans_.collect(prof_);
+    spans_.begin(*prof_, span::force_update);
   }
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
   bind_model_textures();
@@ -356,9 +352,9 @@ void GlPipeline::step() {
     }
     run_pass(id, io);
     if (forces_) forces_->update_issued();
-    check_debug(name_ + " pass " + std::to_string(&g - passes_.data()));
+    if (debug) check_debug(name_ + " pass " + std::to_string(&g - passes_.data()));  // no string otherwise
   }
-  if (!forces_) timer_->end();
+  if (timed) spans_.end();
   check(name_ + " step");
   cur_ = d;
   t_ += dt;
@@ -366,23 +362,9 @@ void GlPipeline::step() {
   if (integrator_ == Integrator::verlet) has_prev_ = true;
 }
 
-void GlPipeline::collect_steps() {
-  const std::vector<double> ms = timer_->take();
-  if (prof_)
-    for (std::size_t k = 0; k < ms.size() && k < profiled_.size(); ++k)
-      prof_->add({span::force_update, profiled_[k].step, profiled_[k].start_ms, ms[k], timer_->method()});
-  profiled_.clear();
-  step_ms_.insert(step_ms_.end(), ms.begin(), ms.end());
-}
-
-std::vector<double> GlPipeline::take_step_ms() {
-  collect_steps();
-  return std::exchange(step_ms_, {});
-}
-
 void GlPipeline::set_profiler(Profiler* p) {
   if (forces_) return;  // the external force stage times the passes
-  collect_steps();
+  spans_.collect(prof_);
   prof_ = p;
 }
 

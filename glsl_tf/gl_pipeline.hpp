@@ -44,13 +44,12 @@ class GlPipeline : public Pipeline {
   State state() override;
   void step() override;
   double max_displacement() override;
-  std::string timing_method() const override { return timer_->method(); }
+  std::string timing_method() const override { return spans_.method(); }
 
   // The current positions, one vec4 per node (w: inverse mass), ready to be read by GL.
   GLuint position_buffer();
-  // GPU time of each step since the last call, ms (timing_method() says how it is taken).
-  std::vector<double> take_step_ms();
-  // Each step's passes are one force+update span (without an external force stage).
+  // While profiled, each step's passes are one force+update span timed by the GL clock
+  // (without an external force stage, which times the passes itself).
   void set_profiler(Profiler* p) override;
   // "grid arithmetic" or "adjacency buffer": how the shaders find a node's springs.
   std::string neighbour_mode() const { return stencil_.empty() ? "adjacency buffer" : "grid arithmetic"; }
@@ -116,15 +115,8 @@ class GlPipeline : public Pipeline {
   Texture adj_offset_tex_, adj_entry_tex_, adj_rest_tex_;
   Program reduce_, copy_;
   GLint reduce_n_ = -1, copy_n_ = -1;
-  std::unique_ptr<Timer> timer_;  // times every step (without an external force stage)
-  std::vector<double> step_ms_;    // step times collected from timer_
   Profiler* prof_ = nullptr;
-  struct StepStart {
-    int step;
-    double start_ms;
-  };
-  std::vector<StepStart> profiled_;  // steps timed since the last collection, while profiled
-  void collect_steps();              // timer_ -> step_ms_ (and spans for profiled steps)
+  TimerSpans spans_;  // the profiled steps
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;

@@ -47,12 +47,6 @@ GLint bound_framebuffer(GLenum which = GL_DRAW_FRAMEBUFFER_BINDING) {
   return id;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 struct Renderer::Impl {
@@ -64,7 +58,7 @@ struct Renderer::Impl {
   Program prog;
   VertexArray vao;
   Buffer upload, indices;
-  Texture upload_tex, draw_tex;
+  Texture draw_tex;
   GLsizei index_count = 0;
   Mat4 view_proj{};
   Vec3f eye;
@@ -275,8 +269,6 @@ nlohmann::json run_manifest(Pipeline& p) {
   const ContextInfo& c = context();
   nlohmann::json j = {{"vendor", c.vendor}, {"renderer", c.renderer}, {"version", c.version}, {"platform", c.platform}};
   if (auto* g = dynamic_cast<GlPipeline*>(&p)) {
-    j["update_ms_median"] = median(g->take_step_ms());
-    j["update_timing"] = g->timing_method();
     j["neighbours"] = g->neighbour_mode();
   }
   return j;

@@ -64,7 +64,7 @@ class FrameWriter {
 };
 
 // For a run's manifest: GL vendor, renderer, version and platform and, for a GL pipeline,
-// its median GPU update time per step and how it was timed; null when no GL context was made.
+// how its shaders find neighbours; null when no GL context was made.
 nlohmann::json run_manifest(Pipeline& p);
 
 }  // namespace deformlab::gl
