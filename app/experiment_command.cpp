@@ -1,6 +1,5 @@
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 
@@ -12,16 +11,6 @@
 
 namespace deformlab::app {
 
-namespace {
-
-bool has_calibration(const std::filesystem::path& dir) {
-  std::ifstream in(dir / "manifest.json");
-  if (!in) return false;
-  const nlohmann::json m = nlohmann::json::parse(in, nullptr, false);
-  return m.is_object() && m.contains("calibration") && m["calibration"].is_object();
-}
-
-}  // namespace
 
 int experiment_command(const ExperimentArgs& a) {
   Experiment x;
@@ -49,14 +38,14 @@ int experiment_command(const ExperimentArgs& a) {
   return report_errors([&] {
     if (a.report_only && !calibration.is_null()) {
       // Records the calibration given in the folder's manifest; the cells stay as they are.
-      std::ifstream in(dir / "manifest.json");
-      if (!in) throw std::invalid_argument("no manifest.json in " + dir.string());
-      nlohmann::json manifest = nlohmann::json::parse(in);
+      nlohmann::json manifest = read_manifest(dir);
+      if (!manifest.is_object()) throw std::invalid_argument("no manifest.json in " + dir.string());
       manifest["calibration"] = calibration;
       write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
     }
     if (!a.report_only) {
-      if (calibration.is_null() && !has_calibration(dir)) {
+      const nlohmann::json earlier = read_manifest(dir);
+      if (calibration.is_null() && !(earlier.is_object() && earlier.value("calibration", nlohmann::json()).is_object())) {
         // Measured once per results folder, where this machine can (CUDA and GL together).
         try {
           std::cout << "calibrating this device (`deformlab calibrate`)" << std::endl;

@@ -35,7 +35,6 @@ class Buffer {
   }
   T* get() const { return p_; }
   std::size_t size() const { return n_; }
-  std::size_t bytes() const { return n_ * sizeof(T); }
 
  private:
   T* p_ = nullptr;

@@ -393,16 +393,6 @@ class Impl final : public CudaPipeline, private ForceKernels {
     return ms;
   }
 
-  std::int64_t device_bytes() const override {
-    std::int64_t b = spheres_.bytes() + offset_.bytes() + links_.bytes() + springs_.bytes();
-    for (const auto& a : x_) b += a.bytes();
-    for (const auto& a : v_) b += a.bytes();
-    for (const auto& a : sx_) b += a.bytes();
-    for (const auto& a : sv_) b += a.bytes();
-    for (const auto& a : acc_) b += a.bytes();
-    return b;
-  }
-
  private:
   // Uploads go through the pipeline's stream, ordered after the steps already queued.
   void copy_in(void* dst, const void* src, std::size_t bytes, const char* what) {

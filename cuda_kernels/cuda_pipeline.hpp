@@ -43,8 +43,6 @@ class CudaPipeline : public Pipeline {
   virtual Energy energy() = 0;
   // GPU time of `steps` steps, ms, from CUDA events recorded around them.
   virtual double timed_steps(int steps) = 0;
-  // Device memory held by the pipeline, bytes.
-  virtual std::int64_t device_bytes() const = 0;
   std::string timing_method() const override { return "CUDA events"; }
 };
 

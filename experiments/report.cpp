@@ -207,11 +207,13 @@ void write_stages(std::ostringstream& md, const fs::path& dir, const std::string
 }  // namespace
 
 fs::path write_report(const fs::path& dir) {
-  std::ifstream min(dir / "manifest.json");
-  if (!min) throw std::invalid_argument("no manifest.json in " + dir.string());
-  const json manifest = json::parse(min);
+  const json manifest = read_manifest(dir);
+  if (!manifest.is_object() || !manifest.contains("experiment"))
+    throw std::invalid_argument("no sweep manifest.json in " + dir.string());
   const json& xj = manifest["experiment"];
-  const Sweep sweep = *parse_sweep(xj, "manifest.experiment");
+  const std::optional<Sweep> parsed = parse_sweep(xj, "manifest.experiment");
+  if (!parsed) throw std::invalid_argument(dir.string() + ": its experiment has no sweep");
+  const Sweep& sweep = *parsed;
   const auto cells = load_cells(dir);
   const std::string table = sweep.paper_table;
   const bool by_pipeline = table == "table3";
@@ -222,9 +224,11 @@ fs::path write_report(const fs::path& dir) {
     return p + "|" + i + "|" + o.dump() + "|" + std::to_string(n);
   };
   std::set<int> sizes;
+  std::map<int, std::int64_t> nodes_at;  // as the cells of each size record it
   for (const auto& c : cells) {
     at[key(c["pipeline"], c["integrator"], c["options"], c["size"])] = &c;
     sizes.insert(c["size"].get<int>());
+    if (c.contains("nodes")) nodes_at[c["size"].get<int>()] = c["nodes"].get<std::int64_t>();
   }
 
   // Columns in sweep order, grouped.
@@ -248,12 +252,12 @@ fs::path write_report(const fs::path& dir) {
   std::ostringstream md;
   const std::string name = xj.value("name", std::string("experiment"));
   md << "# " << name << "\n\n" << xj.value("description", std::string()) << "\n\n";
-  const json& m = manifest["machine"];
+  const json m = manifest.value("machine", json::object());
+  const json build = manifest.value("build", json::object());
   md << "- Machine: " << m.value("cpu", std::string("?")) << ", " << m.value("hardware_threads", 0)
      << " hardware threads, " << m.value("os", std::string("?")) << "\n";
-  md << "- Build: deformlab " << manifest["build"].value("deformlab", std::string()) << " ("
-     << manifest["build"].value("git", std::string()) << "), " << manifest["build"].value("compiler", std::string())
-     << ", CUDA " << manifest["build"].value("cuda", std::string()) << "\n";
+  md << "- Build: deformlab " << build.value("deformlab", std::string()) << " (" << build.value("git", std::string())
+     << "), " << build.value("compiler", std::string()) << ", CUDA " << build.value("cuda", std::string()) << "\n";
   const json calibration = manifest.value("calibration", json());
   const Ceilings ceil = ceilings_of(calibration);
   if (ceil.any()) {
@@ -264,7 +268,8 @@ fs::path write_report(const fs::path& dir) {
   } else {
     md << "- No calibration recorded: times are not shown against ceilings\n";
   }
-  for (const auto& [p, status] : manifest["pipelines"].items())
+  const json availability = manifest.value("pipelines", json::object());
+  for (const auto& [p, status] : availability.items())
     if (status != "available") md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
   md << "- Method: ";
   for (const auto& c : cells)
@@ -318,8 +323,9 @@ fs::path write_report(const fs::path& dir) {
     for (const auto& c : t.columns) series.push_back({c.label, {}, {}, false});
     for (const auto& pc : pcols) series.push_back({pc.label, {}, {}, true});
     for (int n : sizes) {
-      const double nodes = sweep.sizes.empty() ? 0 : double(n) * n;
-      md << "| " << n << "² | " << std::int64_t(nodes) << " |";
+      const auto counted = nodes_at.find(n);
+      const double nodes = counted == nodes_at.end() ? 0 : double(counted->second);
+      md << "| " << n << "² | " << (nodes > 0 ? std::to_string(counted->second) : "-") << " |";
       for (std::size_t k = 0; k < t.columns.size(); ++k) {
         const auto& c = t.columns[k];
         const auto it = at.find(key(c.pipeline, c.integrator, c.options, n));

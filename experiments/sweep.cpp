@@ -53,11 +53,6 @@ int positive(const json& j, const std::string& where) {
   return j.get<int>();
 }
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
@@ -233,7 +228,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
                         {"per_step", double(g.spans) / g.steps}});
     if (!stages.empty()) r["stages"] = stages;
     r["status"] = "ok";
-    r["median_ms"] = median_of(ms_per_step);
+    r["median_ms"] = median(ms_per_step);
     r["min_ms"] = *std::min_element(ms_per_step.begin(), ms_per_step.end());
     r["samples_ms"] = ms_per_step;
     r["stable"] = d == d;
@@ -301,12 +296,18 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 
 void write_atomically(const fs::path& file, const std::string& text) {
   const fs::path tmp = file.string() + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
+  std::ofstream out(tmp);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + tmp.string());
   fs::rename(tmp, file);
+}
+
+json read_manifest(const fs::path& dir) {
+  std::ifstream in(dir / "manifest.json");
+  if (!in) return nullptr;
+  json j = json::parse(in, nullptr, false);
+  return j.is_discarded() ? json(nullptr) : j;
 }
 
 std::vector<json> load_cells(const fs::path& dir) {
@@ -330,12 +331,9 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   // The calibration given, else the one an earlier run of this folder recorded; the frames
   // an earlier run rendered.
   manifest["calibration"] = o.calibration;
-  if (fs::exists(dir / "manifest.json")) {
-    std::ifstream in(dir / "manifest.json");
-    const json old = json::parse(in, nullptr, false);
-    if (old.is_object() && old.contains("calibration") && o.calibration.is_null())
-      manifest["calibration"] = old["calibration"];
-    if (old.is_object() && old.contains("frames") && fs::exists(dir / "frames")) manifest["frames"] = old["frames"];
+  if (const json old = read_manifest(dir); old.is_object()) {
+    if (old.contains("calibration") && o.calibration.is_null()) manifest["calibration"] = old["calibration"];
+    if (old.contains("frames") && fs::exists(dir / "frames")) manifest["frames"] = old["frames"];
   }
   json devices = json::object();
   for (const auto& p : s.pipelines)

@@ -78,6 +78,9 @@ nlohmann::json render_frames(const Experiment& x, const Sweep& s, const std::fil
 // Reads every cell result in `dir`/cells/.
 std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);
 
+// `dir`/manifest.json, or null when there is none or it is not JSON.
+nlohmann::json read_manifest(const std::filesystem::path& dir);
+
 // Writes `text` to `file` through a temporary file and a rename.
 void write_atomically(const std::filesystem::path& file, const std::string& text);
 

@@ -15,7 +15,7 @@ class TfPipeline final : public GlPipeline {
       : GlPipeline(s, forces ? "hybrid" : "glsl-tf", forces) {
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
-    if (separate < 4) throw std::invalid_argument("glsl-tf needs 4 separate transform feedback buffers");
+    if (separate < 4) throw std::invalid_argument(name_ + " needs 4 separate transform feedback buffers");
     for (int k = 0; k < 2; ++k) {
       GLuint id = 0;
       glGenVertexArrays(1, &id);

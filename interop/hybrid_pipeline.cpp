@@ -2,7 +2,6 @@
 
 #include <stdexcept>
 
-#include "cuda_kernels/check.cuh"
 #include "cuda_kernels/event_spans.hpp"
 #include "cuda_kernels/force_stage.hpp"
 #include "glsl_tf/gl_pipeline.hpp"
@@ -96,9 +95,6 @@ class HybridPipeline final : public Pipeline {
  public:
   HybridPipeline(const PipelineSetup& s, const HybridOptions& o) : p_(s.params) {
     if (const std::string why = hybrid_unsupported(s.integrator); !why.empty()) throw std::invalid_argument(why);
-    if (o.force == cuda::Variant::fused)
-      throw std::invalid_argument("the hybrid pipelines run a CUDA force pass: naive, tiled or scatter, not fused");
-    validate(p_, s.model.node_count());
     sb_ = make_shared_buffers(o.mode);  // selects the CUDA device behind the GL context
     fs_ = cuda::make_force_stage(s.model, p_, o.force, o.tile);
     forces_ = std::make_unique<HybridForces>(p_, *sb_, *fs_);

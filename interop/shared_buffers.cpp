@@ -142,9 +142,11 @@ class MapBuffers final : public SharedBuffers {
 
   void to_cuda(const std::vector<GLuint>& buffers) override {
     if (!mapped_.empty()) throw std::logic_error("map: hand-off to CUDA while buffers are mapped");
-    for (GLuint b : buffers) mapped_.push_back(entry(b).resource);
-    if (mapped_.empty()) return;
-    check(cudaGraphicsMapResources(int(mapped_.size()), mapped_.data(), stream_), "mapping GL buffers for CUDA");
+    std::vector<cudaGraphicsResource_t> resources;
+    for (GLuint b : buffers) resources.push_back(entry(b).resource);
+    if (resources.empty()) return;
+    check(cudaGraphicsMapResources(int(resources.size()), resources.data(), stream_), "mapping GL buffers for CUDA");
+    mapped_ = std::move(resources);  // only once mapped: a failed map leaves nothing to unmap
     for (GLuint b : buffers) {
       Entry& e = entry(b);
       std::size_t size = 0;
@@ -296,7 +298,10 @@ class StagedBuffers final : public SharedBuffers {
     e.bytes = bytes;
     e.access = access;
     check(cudaMalloc(&e.device, bytes), "allocating a staged buffer's device copy");
-    check(cudaMallocHost(&e.host, bytes), "allocating a staged buffer's host copy");
+    if (const cudaError_t r = cudaMallocHost(&e.host, bytes); r != cudaSuccess) {
+      cudaFree(e.device);
+      check(r, "allocating a staged buffer's host copy");
+    }
     const GLuint id = e.buffer.id();
     entries_.emplace(id, std::move(e));
     return id;

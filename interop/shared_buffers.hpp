@@ -42,8 +42,6 @@ int cuda_device_of_gl();
 class SharedBuffers {
  public:
   virtual ~SharedBuffers();  // destroys the stream
-  Mode mode() const { return mode_; }
-  int device() const { return device_; }
   CUstream_st* stream() const { return stream_; }
 
   // A new buffer of `bytes` (contents undefined); returns its GL name, valid as long as
@@ -58,8 +56,6 @@ class SharedBuffers {
   // Hand-off to GL: CUDA work queued on stream() so far completes before GL commands
   // issued from now on (and its writes are visible to them).
   virtual void to_gl() = 0;
-  // True when no hand-off waits on the CPU (external-gpusync).
-  bool gpu_sync() const { return mode_ == Mode::external_gpusync; }
 
  protected:
   SharedBuffers(Mode m, int device, CUstream_st* s) : mode_(m), device_(device), stream_(s) {}
