@@ -12,8 +12,8 @@
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
 #if DEFORMLAB_GL_RENDER
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/render.hpp"
+#include "gl/context.hpp"
+#include "gl/render.hpp"
 #endif
 
 namespace deformlab::app {

@@ -8,8 +8,8 @@
 
 #include "bench.hpp"
 #include "core/state.hpp"
-#include "glsl_tf/gl_pipeline.hpp"
-#include "glsl_tf/pipelines_internal.hpp"
+#include "gl/gl_pipeline.hpp"
+#include "gl/pipelines_internal.hpp"
 
 namespace deformlab::bench {
 

@@ -12,8 +12,8 @@
 #include "core/profiler.hpp"
 #include "core/state.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/pipelines_internal.hpp"
+#include "gl/context.hpp"
+#include "gl/pipelines_internal.hpp"
 #include "interop/calibrate.hpp"
 #include "interop/hybrid.hpp"
 

@@ -7,7 +7,7 @@
 #include "cuda_kernels/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_GL
-#include "glsl_tf/pipelines.hpp"
+#include "gl/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_INTEROP
 #include "interop/pipelines.hpp"

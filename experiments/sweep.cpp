@@ -14,8 +14,8 @@
 #include "output.hpp"
 #include "pipelines.hpp"
 #if DEFORMLAB_HAVE_GL
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/render.hpp"
+#include "gl/context.hpp"
+#include "gl/render.hpp"
 #endif
 
 namespace deformlab {

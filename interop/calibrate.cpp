@@ -8,8 +8,8 @@
 
 #include "cuda_kernels/check.cuh"
 #include "cuda_kernels/cuda_pipeline.hpp"
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/objects.hpp"
+#include "gl/context.hpp"
+#include "gl/objects.hpp"
 #include "shared_buffers.hpp"
 
 namespace deformlab::interop {

@@ -4,8 +4,8 @@
 
 #include "cuda_kernels/event_spans.hpp"
 #include "cuda_kernels/force_stage.hpp"
-#include "glsl_tf/gl_pipeline.hpp"
-#include "glsl_tf/pipelines_internal.hpp"
+#include "gl/gl_pipeline.hpp"
+#include "gl/pipelines_internal.hpp"
 #include "hybrid.hpp"
 
 namespace deformlab::interop {

@@ -1,6 +1,6 @@
 #include "pipelines.hpp"
 
-#include "glsl_tf/context.hpp"
+#include "gl/context.hpp"
 #include "hybrid.hpp"
 
 namespace deformlab {

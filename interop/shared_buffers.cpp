@@ -15,8 +15,8 @@
 #include "cuda_kernels/check.cuh"
 #include "cuda_kernels/cuda_pipeline.hpp"
 #include "gl_ext.hpp"
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/objects.hpp"
+#include "gl/context.hpp"
+#include "gl/objects.hpp"
 #include "vulkan_semaphore.hpp"
 
 namespace deformlab::interop {

@@ -7,7 +7,7 @@
 //   external-gpusync  the same memory; a Vulkan timeline semaphore imported into GL and CUDA
 //                     orders the two on the GPU, the CPU never waits
 //   staged            GL and CUDA keep their own buffers; copies go through host memory
-// The GL context (glsl_tf/context.hpp) must be current on the calling thread; CUDA work
+// The GL context (gl/context.hpp) must be current on the calling thread; CUDA work
 // runs on the device behind it (cudaGLGetDevices), on the stream these buffers own.
 #pragma once
 #define EGL_NO_X11

@@ -17,7 +17,7 @@
 #define DRAG_HARD 1
 #define DRAG_SPRING 2
 
-// Static for a run; layout mirrored by SimParams in glsl_tf/gl_pipeline.cpp.
+// Static for a run; layout mirrored by SimParams in gl/gl_pipeline.cpp.
 layout(std140, binding = 0) uniform SimParams {
   ivec4 dims;          // nx, ny, nz, node count
   vec4 gravity_dt;     // gravity (m/s^2), dt (s)

@@ -8,7 +8,7 @@
 #include <sys/wait.h>
 
 #include "gl_test_support.hpp"
-#include "glsl_tf/objects.hpp"
+#include "gl/objects.hpp"
 
 namespace deformlab::test {
 namespace {

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "core/pipeline.hpp"
-#include "glsl_tf/context.hpp"
-#include "glsl_tf/pipelines_internal.hpp"
+#include "gl/context.hpp"
+#include "gl/pipelines_internal.hpp"
 
 #define DEFORMLAB_REQUIRE_GL()                                                \
   do {                                                                        \

@@ -18,7 +18,7 @@
 
 #include "core/cpu_backend.hpp"
 #include "gl_test_support.hpp"
-#include "glsl_tf/gl_pipeline.hpp"
+#include "gl/gl_pipeline.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab::test {

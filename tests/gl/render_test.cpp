@@ -5,7 +5,7 @@
 
 #include "core/cpu_backend.hpp"
 #include "gl_test_support.hpp"
-#include "glsl_tf/render.hpp"
+#include "gl/render.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab::test {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cuda_kernels/cuda_pipeline.hpp"
-#include "glsl_tf/context.hpp"
+#include "gl/context.hpp"
 #include "interop/hybrid.hpp"
 #include "interop/pipelines.hpp"
 #include "tests/support/test_states.hpp"

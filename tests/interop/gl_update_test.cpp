@@ -7,8 +7,8 @@
 
 #include "core/cpu_backend.hpp"
 #include "core/forces.hpp"
-#include "glsl_tf/gl_pipeline.hpp"
-#include "glsl_tf/pipelines_internal.hpp"
+#include "gl/gl_pipeline.hpp"
+#include "gl/pipelines_internal.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab::test {

@@ -11,7 +11,7 @@
 #include <tuple>
 #include <vector>
 
-#include "glsl_tf/objects.hpp"
+#include "gl/objects.hpp"
 #include "interop/shared_buffers.hpp"
 
 namespace deformlab::test {
