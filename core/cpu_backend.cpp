@@ -10,13 +10,14 @@
 #include <limits>
 #include <stdexcept>
 
-#include "forces.hpp"
+#include "step_params.hpp"
 
 namespace deformlab {
 namespace {
 
 template <class Real>
 class CpuPipeline final : public Pipeline {
+  using P = Physics<Real>;
   using V = Vec3<Real>;
   struct Slot {
     std::vector<V> x, v;
@@ -30,6 +31,8 @@ class CpuPipeline final : public Pipeline {
   CpuPipeline(const PipelineSetup& s, bool parallel)
       : m_(s.model),
         p_(s.params),
+        sp_(step_params<Real>(s.model, s.params)),
+        stencil_(stencil_entries<Real>(s.model)),
         sched_(make_schedule(s.integrator)),
         threads_(parallel ? std::clamp(m_.node_count() / kNodesPerThread, 1, omp_get_max_threads()) : 1) {
     const std::size_t n = m_.rest_position.size();
@@ -73,9 +76,8 @@ class CpuPipeline final : public Pipeline {
     for (const Pass& pass : sched_.passes) {
       switch (pass.op) {
         case Pass::Op::force: force(slots_[pass.src], acc_[pass.acc], t_ + pass.time_fraction * p_.dt); break;
-        case Pass::Op::stage: stage(pass); break;
         case Pass::Op::combine: combine(pass); break;
-        case Pass::Op::fused: fused(); break;
+        case Pass::Op::update: update(); break;
         case Pass::Op::solve: solve(); break;
       }
     }
@@ -85,8 +87,6 @@ class CpuPipeline final : public Pipeline {
   double max_displacement() override { return last_disp_; }
 
  private:
-  bool hard_drag(int i) const { return p_.drag.active() && !p_.drag.as_spring && i == p_.drag.node; }
-
   template <class F>
   void for_nodes(F&& f) {
     const int n = m_.node_count();
@@ -94,81 +94,52 @@ class CpuPipeline final : public Pipeline {
     for (int i = 0; i < n; ++i) f(i);
   }
 
-  void force(const Slot& s, std::vector<V>& a, double t) {
-    const V g(p_.gravity), wind(p_.wind);
-    const Real c = p_.damping;
-    const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
-    const V target = spring_drag ? V(p_.drag.target(t)) : V{};
-    for_nodes([&](int i) {
-      const Real w = m_.inv_mass[i];
-      if (w == Real(0) || hard_drag(i)) { a[i] = V{}; return; }
-      V f{};
-      for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
-        const int sp = m_.adj_spring[e], j = m_.adj_node[e];
-        const int k = int(m_.kind[sp]);
-        f += spring_force(s.x[i], s.x[j], s.v[i], s.v[j], Real(m_.stiffness[k]), Real(m_.damping[k]),
-                          Real(m_.rest_length[sp]));
+  // Sum of the spring forces on node i: grids by their stencil, other models by adjacency.
+  V springs(const Slot& s, int i) const {
+    V f{};
+    if (m_.grid()) {
+      const int ci = i % sp_.nx, cj = (i / sp_.nx) % sp_.ny, ck = i / (sp_.nx * sp_.ny);
+      for (const auto& e : stencil_) {
+        const int j = P::grid_neighbour(sp_, ci, cj, ck, e.di, e.dj, e.dk);
+        if (j >= 0) f += P::spring_force(s.x[i], s.x[j], s.v[i], s.v[j], e.k, e.kd, e.rest);
       }
-      if (spring_drag && i == p_.drag.node) f += (target - s.x[i]) * Real(p_.drag.stiffness);
-      a[i] = acceleration(f, s.v[i], w, c, wind, g);
-    });
+      return f;
+    }
+    for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
+      const int sp = m_.adj_spring[e], j = m_.adj_node[e];
+      f += P::spring_force(s.x[i], s.x[j], s.v[i], s.v[j], Real(m_.spring_k(sp)), Real(m_.spring_kd(sp)),
+                           Real(m_.rest_length[sp]));
+    }
+    return f;
   }
 
-  void stage(const Pass& pass) {
-    const Real h = Real(pass.coef * p_.dt);
-    const Slot &s0 = slots_[0], &src = slots_[pass.src];
-    Slot& dst = slots_[pass.dst];
-    const auto& a = acc_[pass.acc];
+  void force(const Slot& s, std::vector<V>& a, double t) {
+    const V target = sp_.drag_mode == DRAG_SPRING ? V(p_.drag.target(t)) : V{};
     for_nodes([&](int i) {
-      dst.x[i] = s0.x[i] + src.v[i] * h;
-      dst.v[i] = s0.v[i] + a[i] * h;
+      const Real w = m_.inv_mass[i];
+      a[i] = P::node_fixed(sp_, i, w) ? V{} : P::node_acceleration(sp_, i, w, s.x[i], s.v[i], springs(s, i), target);
     });
   }
 
   void combine(const Pass& pass) {
-    const Real dt = p_.dt;
     const Slot& s0 = slots_[0];
+    Slot& dst = pass.dst == Pass::kResult ? next_ : slots_[pass.dst];
     const int terms = int(pass.weights.size());
     for_nodes([&](int i) {
       V dx{}, dv{};
-      for (int k = 0; k < terms; ++k) {
-        if (pass.weights[k] == 0.0) continue;
-        const Real w = Real(pass.weights[k]);
-        dx += slots_[k].v[i] * w;
-        dv += acc_[k][i] * w;
-      }
-      next_.x[i] = s0.x[i] + dx * dt;
-      next_.v[i] = s0.v[i] + dv * dt;
+      for (int j = 0; j < terms; ++j)
+        if (pass.weights[j] != 0.0) P::add_slope(dx, dv, Real(pass.weights[j]), slots_[j].v[i], acc_[j][i]);
+      P::rk_state(s0.x[i], s0.v[i], dx, dv, sp_.dt, dst.x[i], dst.v[i]);
     });
   }
 
-  void fused() {
-    const Real dt = p_.dt;
+  void update() {
     const Slot& s = slots_[0];
     const auto& a = acc_[0];
-    switch (sched_.integrator) {
-      case Integrator::explicit_euler:
-        for_nodes([&](int i) {
-          next_.x[i] = s.x[i] + s.v[i] * dt;
-          next_.v[i] = s.v[i] + a[i] * dt;
-        });
-        break;
-      case Integrator::semi_implicit_euler:
-        for_nodes([&](int i) {
-          next_.v[i] = s.v[i] + a[i] * dt;
-          next_.x[i] = s.x[i] + next_.v[i] * dt;
-        });
-        break;
-      case Integrator::verlet:
-        for_nodes([&](int i) {
-          const V step = has_prev_ ? (s.x[i] - x_prev_[i]) + a[i] * (dt * dt)
-                                   : s.v[i] * dt + a[i] * (Real(0.5) * dt * dt);
-          next_.x[i] = s.x[i] + step;
-          next_.v[i] = step * (Real(1) / dt);
-        });
-        break;
-      default: throw std::logic_error("fused update for a multi-pass integrator");
-    }
+    for_nodes([&](int i) {
+      P::one_pass_update(int(sched_.rule), Real(1), s.x[i], s.v[i], a[i], x_prev_[i], has_prev_, sp_.dt,
+                         next_.x[i], next_.v[i]);
+    });
   }
 
   // Backward Euler, linearised once per step (Baraff & Witkin 1998):
@@ -184,7 +155,7 @@ class CpuPipeline final : public Pipeline {
     const Real dt = p_.dt, c = p_.damping;
     const Slot& s = slots_[0];
     force(s, acc_[0], t_);
-    auto fixed = [&](int i) { return m_.inv_mass[i] == 0.f || hard_drag(i); };
+    auto fixed = [&](int i) { return P::node_fixed(sp_, i, Real(m_.inv_mass[i])); };
     auto e3 = [](const V& v) { return E3(v.x, v.y, v.z); };
 
     std::vector<Eigen::Triplet<Real>> trip;
@@ -198,13 +169,12 @@ class CpuPipeline final : public Pipeline {
     };
     for (int e = 0; e < m_.spring_count(); ++e) {
       const int i = m_.spring_i[e], j = m_.spring_j[e];
-      const int k = int(m_.kind[e]);
       const E3 d = e3(s.x[i] - s.x[j]);
       const Real len = d.norm();
       if (len == Real(0)) continue;
       const E3 u = d / len;
       const M3 uu = u * u.transpose();
-      const Real ks = m_.stiffness[k], kd = m_.damping[k], rest = m_.rest_length[e];
+      const Real ks = m_.spring_k(e), kd = m_.spring_kd(e), rest = m_.rest_length[e];
       const Real geo = std::max(Real(0), Real(1) - rest / len);
       const M3 K = -ks * (geo * (M3::Identity() - uu) + uu);  // df_i/dx_i
       const M3 D = -kd * uu;                                  // df_i/dv_i
@@ -256,46 +226,30 @@ class CpuPipeline final : public Pipeline {
   // Constraints on next_, then next_ becomes the current state; records the largest
   // displacement of the step (NaN if any value is not finite).
   void constrain_and_commit() {
-    const Real dt = p_.dt;
     const double t1 = t_ + p_.dt;
     const V drag_target = p_.drag.active() ? V(p_.drag.target(t1)) : V{};
-    const Real ground = p_.ground ? Real(*p_.ground) : Real(0);
     Slot& s = slots_[0];
-    double disp = 0.0;
-    bool finite = true;
+    Real disp = 0;
     const int n = m_.node_count();
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1) reduction(max : disp) \
-    reduction(&& : finite)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1) reduction(max : disp)
     for (int i = 0; i < n; ++i) {
-      V& x = next_.x[i];
-      V& v = next_.v[i];
-      if (m_.inv_mass[i] == 0.f) {
-        x = s.x[i];
-        v = V{};
-      } else if (hard_drag(i)) {
-        x = drag_target;
-        v = (x - s.x[i]) * (Real(1) / dt);
-      } else {
-        if (p_.ground) ground_constraint(x, v, ground);
-        for (const auto& sph : p_.spheres) sphere_constraint(x, v, V(sph.center), Real(sph.radius));
-      }
-      const double d = double(norm(x - s.x[i]));
-      finite = finite && std::isfinite(d) && std::isfinite(double(v.x)) && std::isfinite(double(v.y)) &&
-               std::isfinite(double(v.z));
-      disp = std::max(disp, d);
+      P::constrain_node(sp_, i, Real(m_.inv_mass[i]), s.x[i], drag_target, next_.x[i], next_.v[i]);
+      disp = std::max(disp, P::displacement(next_.x[i], s.x[i], next_.v[i]));
     }
-    if (sched_.integrator == Integrator::verlet) {
+    if (sched_.rule == UpdateRule::verlet) {
       x_prev_.swap(s.x);  // the old current positions become the previous ones
       has_prev_ = true;
     }
     std::swap(s.x, next_.x);
     std::swap(s.v, next_.v);
     t_ = t1;
-    last_disp_ = finite ? disp : std::numeric_limits<double>::quiet_NaN();
+    last_disp_ = std::isinf(disp) ? std::numeric_limits<double>::quiet_NaN() : double(disp);
   }
 
   const Model& m_;
   Params p_;
+  typename P::StepParams sp_;
+  std::vector<typename P::StencilEntry> stencil_;
   Schedule sched_;
   int threads_;
   std::vector<Slot> slots_;  // 0: current state, 1..: stage states

@@ -1,21 +1,19 @@
 #include "energy.hpp"
 
+#include "step_params.hpp"
+
 namespace deformlab {
 
 Energy energy(const Model& m, const Params& p, const State& s) {
+  using P = Physics<double>;
+  const P::StepParams sp = step_params<double>(m, p);
   Energy e;
-  const Vec3d g(p.gravity), wind(p.wind);
   for (int i = 0; i < m.node_count(); ++i) {
-    if (m.inv_mass[i] == 0.f) continue;
-    const double mass = 1.0 / m.inv_mass[i];
-    const Vec3d v(s.v[i]), x(s.x[i]);
-    e.kinetic += 0.5 * mass * dot(v, v);
-    e.field -= dot(g * mass + wind, x);
+    e.kinetic += P::kinetic_energy(m.inv_mass[i], Vec3d(s.v[i]));
+    e.field += P::field_energy(sp, m.inv_mass[i], Vec3d(s.x[i]));
   }
-  for (int k = 0; k < m.spring_count(); ++k) {
-    const double stretch = norm(Vec3d(s.x[m.spring_i[k]]) - Vec3d(s.x[m.spring_j[k]])) - m.rest_length[k];
-    e.spring += 0.5 * m.stiffness[int(m.kind[k])] * stretch * stretch;
-  }
+  for (int k = 0; k < m.spring_count(); ++k)
+    e.spring += P::spring_energy(Vec3d(s.x[m.spring_i[k]]), Vec3d(s.x[m.spring_j[k]]), m.spring_k(k), m.rest_length[k]);
   return e;
 }
 

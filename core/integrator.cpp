@@ -2,18 +2,73 @@
 
 #include <stdexcept>
 
+#include "physics.hpp"
+
 namespace deformlab {
 
+static_assert(int(UpdateRule::runge_kutta) == RULE_RUNGE_KUTTA &&
+              int(UpdateRule::semi_implicit_euler) == RULE_SEMI_IMPLICIT_EULER &&
+              int(UpdateRule::verlet) == RULE_VERLET);
+
+namespace {
+
+Tableau euler() {
+  Tableau t;
+  t.b[0] = 1.0;
+  return t;
+}
+Tableau midpoint() {
+  Tableau t;
+  t.stages = 2;
+  t.c = {0.0, 0.5};
+  t.a[1][0] = 0.5;
+  t.b = {0.0, 1.0};
+  return t;
+}
+Tableau kutta3() {
+  Tableau t;
+  t.stages = 3;
+  t.c = {0.0, 0.5, 1.0};
+  t.a[1][0] = 0.5;
+  t.a[2][0] = -1.0;
+  t.a[2][1] = 2.0;
+  t.b = {1.0 / 6, 4.0 / 6, 1.0 / 6};
+  return t;
+}
+Tableau classic4() {
+  Tableau t;
+  t.stages = 4;
+  t.c = {0.0, 0.5, 0.5, 1.0};
+  t.a[1][0] = 0.5;
+  t.a[2][1] = 0.5;
+  t.a[3][2] = 1.0;
+  t.b = {1.0 / 6, 2.0 / 6, 2.0 / 6, 1.0 / 6};
+  return t;
+}
+
+IntegratorInfo entry(Integrator id, std::string_view name, std::string_view alias, UpdateRule rule, Tableau t, int order,
+                     std::string_view summary) {
+  return {id, name, alias, rule, t, order, summary, rule == UpdateRule::runge_kutta ? t.stages : 1};
+}
+
+}  // namespace
+
 const std::vector<IntegratorInfo>& integrators() {
+  using R = UpdateRule;
   static const std::vector<IntegratorInfo> all = {
-      {Integrator::explicit_euler, "explicit-euler", "", 1, 1, "forward Euler; unstable without damping"},
-      {Integrator::semi_implicit_euler, "semi-implicit-euler", "implicit-euler", 1, 1,
-       "symplectic Euler (the paper's \"implicit Euler\", eq. 7)"},
-      {Integrator::midpoint, "midpoint", "", 2, 2, "RK2, forces re-evaluated at the half step"},
-      {Integrator::rk4, "rk4", "", 4, 4, "classical Runge-Kutta, four force evaluations (not the paper's eqs. 10-11)"},
-      {Integrator::verlet, "verlet", "midpoint-verlet", 1, 2, "position Verlet (the paper's eq. 6; its eq. 9 is not a known scheme)"},
-      {Integrator::backward_euler, "backward-euler", "", 1, 1,
-       "implicit Euler, linearised, sparse conjugate gradient (Baraff & Witkin)"},
+      entry(Integrator::explicit_euler, "explicit-euler", "", R::runge_kutta, euler(), 1,
+       "forward Euler; unstable without damping"),
+      entry(Integrator::semi_implicit_euler, "semi-implicit-euler", "implicit-euler", R::semi_implicit_euler, Tableau{}, 1,
+       "symplectic Euler (the paper's \"implicit Euler\", eq. 7)"),
+      entry(Integrator::midpoint, "midpoint", "", R::runge_kutta, midpoint(), 2, "RK2, forces re-evaluated at the half step"),
+      entry(Integrator::rk3, "rk3", "", R::runge_kutta, kutta3(), 3,
+       "Kutta's third-order Runge-Kutta, three force evaluations (its third stage combines the first two)"),
+      entry(Integrator::rk4, "rk4", "", R::runge_kutta, classic4(), 4,
+       "classical Runge-Kutta, four force evaluations (not the paper's eqs. 10-11)"),
+      entry(Integrator::verlet, "verlet", "midpoint-verlet", R::verlet, Tableau{}, 2,
+       "position Verlet (the paper's eq. 6; its eq. 9 is not a known scheme)"),
+      entry(Integrator::backward_euler, "backward-euler", "", R::backward_euler, Tableau{}, 1,
+       "implicit Euler, linearised, sparse conjugate gradient (Baraff & Witkin)"),
   };
   return all;
 }
@@ -40,57 +95,48 @@ std::string integrator_names() {
 }
 
 bool Schedule::single_pass() const {
-  return passes.size() == 2 && passes[0].op == Pass::Op::force && passes[1].op == Pass::Op::fused;
+  return passes.size() == 2 && passes[0].op == Pass::Op::force &&
+         (passes[1].op == Pass::Op::update || (passes[1].op == Pass::Op::combine && passes[1].dst == Pass::kResult));
 }
 
-namespace {
-Pass force_pass(int src, int acc, double time_fraction) {
-  Pass p;
-  p.op = Pass::Op::force;
-  p.src = src; p.acc = acc; p.time_fraction = time_fraction;
-  return p;
+double Schedule::weight() const {
+  return single_pass() && passes[1].op == Pass::Op::combine ? passes[1].weights[0] : 1.0;
 }
-Pass stage_pass(int src, int dst, double coef) {  // reads accel slot `src`
-  Pass p;
-  p.op = Pass::Op::stage;
-  p.src = src; p.dst = dst; p.acc = src; p.coef = coef;
-  return p;
-}
-Pass update_pass(Pass::Op op) {
-  Pass p;
-  p.op = op;
-  return p;
-}
-Pass combine_pass(std::vector<double> weights) {
-  Pass p;
-  p.op = Pass::Op::combine;
-  p.weights = std::move(weights);
-  return p;
-}
-}  // namespace
 
 Schedule make_schedule(Integrator i) {
-  Schedule s{.integrator = i, .passes = {}, .stage_states = 0, .accel_slots = 1};
-  switch (i) {
-    case Integrator::explicit_euler:
-    case Integrator::semi_implicit_euler:
-    case Integrator::verlet:
-      s.passes = {force_pass(0, 0, 0.0), update_pass(Pass::Op::fused)};
+  const IntegratorInfo& in = info(i);
+  Schedule s{.integrator = i, .rule = in.rule, .passes = {}, .stage_states = 0, .accel_slots = 1};
+  Pass p;
+  switch (in.rule) {
+    case UpdateRule::runge_kutta: {
+      const Tableau& t = in.tableau;
+      s.stage_states = t.stages - 1;
+      s.accel_slots = t.stages;
+      for (int st = 0; st < t.stages; ++st) {
+        Pass f;
+        f.op = Pass::Op::force;
+        f.src = f.acc = st;
+        f.time_fraction = t.c[st];
+        s.passes.push_back(f);
+        Pass c;
+        c.op = Pass::Op::combine;
+        const bool last = st + 1 == t.stages;
+        c.dst = last ? Pass::kResult : st + 1;
+        for (int j = 0; j <= st; ++j) c.weights.push_back(last ? t.b[j] : t.a[st + 1][j]);
+        s.passes.push_back(c);
+      }
       break;
-    case Integrator::midpoint:
-      s.stage_states = 1;
-      s.accel_slots = 2;
-      s.passes = {force_pass(0, 0, 0.0), stage_pass(0, 1, 0.5), force_pass(1, 1, 0.5), combine_pass({0.0, 1.0})};
+    }
+    case UpdateRule::semi_implicit_euler:
+    case UpdateRule::verlet:
+      p.op = Pass::Op::force;
+      s.passes.push_back(p);
+      p.op = Pass::Op::update;
+      s.passes.push_back(p);
       break;
-    case Integrator::rk4:
-      s.stage_states = 3;
-      s.accel_slots = 4;
-      s.passes = {force_pass(0, 0, 0.0), stage_pass(0, 1, 0.5), force_pass(1, 1, 0.5),
-                  stage_pass(1, 2, 0.5), force_pass(2, 2, 0.5), stage_pass(2, 3, 1.0),
-                  force_pass(3, 3, 1.0), combine_pass({1.0 / 6, 2.0 / 6, 2.0 / 6, 1.0 / 6})};
-      break;
-    case Integrator::backward_euler:
-      s.passes = {update_pass(Pass::Op::solve)};  // its force evaluation (f0) uses accel slot 0
+    case UpdateRule::backward_euler:
+      p.op = Pass::Op::solve;  // its force evaluation (f0) uses accel slot 0
+      s.passes.push_back(p);
       break;
   }
   return s;

@@ -44,26 +44,6 @@ float Model::extent() const {
 
 namespace {
 
-struct Offset { int di, dj, dk; SpringKind kind; };
-
-// Half of each neighbour stencil (the other half is the same springs seen from the far end).
-std::vector<Offset> half_stencil(bool volume) {
-  std::vector<Offset> o;
-  const int kmax = volume ? 1 : 0;
-  for (int dk = -kmax; dk <= kmax; ++dk)
-    for (int dj = -1; dj <= 1; ++dj)
-      for (int di = -1; di <= 1; ++di) {
-        // keep offsets that are lexicographically positive in (dk, dj, di)
-        if (dk < 0 || (dk == 0 && (dj < 0 || (dj == 0 && di <= 0)))) continue;
-        const int nonzero = (di != 0) + (dj != 0) + (dk != 0);
-        o.push_back({di, dj, dk, nonzero == 1 ? SpringKind::structural : SpringKind::shear});
-      }
-  o.push_back({2, 0, 0, SpringKind::flexion});
-  o.push_back({0, 2, 0, SpringKind::flexion});
-  if (volume) o.push_back({0, 0, 2, SpringKind::flexion});
-  return o;
-}
-
 // Grid builders index node (i, j, k) as (k*ny + j)*nx + i with axes mapped by `pos`.
 template <class PosFn>
 Model build_grid(Topology t, int nx, int ny, int nz, float h, const Material& mat, PosFn pos) {
@@ -84,20 +64,20 @@ Model build_grid(Topology t, int nx, int ny, int nz, float h, const Material& ma
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) m.rest_position[(std::size_t(k) * ny + j) * nx + i] = pos(i, j, k);
 
-  const auto stencil = half_stencil(nz > 1 || t == Topology::lattice);
+  // Each node's own springs: the second half of the grid stencil.
+  const int size = grid_stencil_size(m.volume());
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
-        for (const auto& o : stencil) {
+        for (int e = size / 2; e < size; ++e) {
+          const GridOffset o = grid_offset(m.volume(), e);
           const int a = i + o.di, b = j + o.dj, c = k + o.dk;
           if (a < 0 || a >= nx || b < 0 || b >= ny || c < 0 || c >= nz) continue;
           const int u = (k * ny + j) * nx + i, v = (c * ny + b) * nx + a;
           m.spring_i.push_back(std::min(u, v));
           m.spring_j.push_back(std::max(u, v));
-          m.kind.push_back(o.kind);
-          // From the offset, not the rounded positions: every spring of one offset shares
-          // one rest length, which grid kernels rely on.
-          m.rest_length.push_back(float(double(h) * std::sqrt(double(o.di * o.di + o.dj * o.dj + o.dk * o.dk))));
+          m.kind.push_back(SpringKind(o.kind));
+          m.rest_length.push_back(grid_rest_length(m, o));
         }
   m.build_adjacency();
   return m;
@@ -175,6 +155,11 @@ std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& e
 
 void pin(Model& m, const std::vector<int>& nodes) {
   for (int v : nodes) m.inv_mass.at(v) = 0.f;
+}
+
+// From the offset, not the rounded positions: every spring of one offset shares one rest length.
+float grid_rest_length(const Model& m, const GridOffset& o) {
+  return float(double(m.spacing) * std::sqrt(double(o.di * o.di + o.dj * o.dj + o.dk * o.dk)));
 }
 
 std::int64_t model_bytes(std::int64_t nodes, std::int64_t springs) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "grid_stencil.hpp"
 #include "vec3.hpp"
 
 namespace deformlab {
@@ -14,8 +15,10 @@ enum class SpringKind : std::uint8_t { structural = 0, shear = 1, flexion = 2 };
 inline constexpr int kSpringKinds = 3;
 const char* to_string(SpringKind k);
 
-// How nodes are laid out. Grids and lattices keep their dimensions so that kernels can
-// find neighbours by index arithmetic; general models only have the spring lists.
+// How nodes are laid out. Grids and lattices are built by the builders from the grid stencil
+// (grid_stencil.hpp), so every backend finds their neighbours by it; general models only
+// have the spring lists. A grid model with its topology set to general is run through its
+// spring lists, as any other general model.
 enum class Topology : std::uint8_t { general, cloth_grid, lattice };
 
 struct Model {
@@ -31,6 +34,9 @@ struct Model {
   std::vector<SpringKind> kind;                  // [s]
   std::array<float, kSpringKinds> stiffness{};   // per kind, N/m
   std::array<float, kSpringKinds> damping{};     // per kind, along the spring axis, N s/m
+  // [s] or empty: per-spring stiffness (N/m) and damping (N s/m) of general models, which
+  // then replace the per-kind values. Grids keep per-kind values.
+  std::vector<float> spring_stiffness, spring_damping;
 
   // Node -> incident springs (CSR): node v's springs are adj_spring[adj_offset[v] ..
   // adj_offset[v+1]), adj_node holds the spring's other end. [n+1], [2s], [2s].
@@ -39,6 +45,10 @@ struct Model {
   int node_count() const { return int(rest_position.size()); }
   int spring_count() const { return int(spring_i.size()); }
   bool pinned(int v) const { return inv_mass[v] == 0.f; }
+  bool grid() const { return topology != Topology::general; }
+  bool volume() const { return topology == Topology::lattice || nz > 1; }  // lattice stencil
+  float spring_k(int e) const { return spring_stiffness.empty() ? stiffness[int(kind[e])] : spring_stiffness[e]; }
+  float spring_kd(int e) const { return spring_damping.empty() ? damping[int(kind[e])] : spring_damping[e]; }
   // Recomputes adj_* from spring_i/j (ordered by spring index within each node).
   void build_adjacency();
   // Largest distance between two rest positions' bounding-box corners.
@@ -67,6 +77,9 @@ enum class PinSet : std::uint8_t { none, top_corners, top_row, list };
 // Nodes of a pin set on a grid or lattice model (list: returns `explicit_nodes`, checked).
 std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& explicit_nodes);
 void pin(Model& m, const std::vector<int>& nodes);
+
+// Rest length of a grid's springs along offset o: spacing x |o|.
+float grid_rest_length(const Model& m, const GridOffset& o);
 
 // Bytes a model of this many nodes and springs needs on the host (model + state).
 std::int64_t model_bytes(std::int64_t nodes, std::int64_t springs);

@@ -1,5 +1,5 @@
-// A small 3-vector usable from host C++ and CUDA device code alike, so that the spring
-// and constraint formulas in forces.hpp / constraints.hpp exist once for every backend.
+// A small 3-vector usable from host C++ and CUDA device code alike, so that the per-node
+// physics (node_physics.h, through physics.hpp) exists once for every backend.
 #pragma once
 #include <cmath>
 
@@ -35,6 +35,18 @@ template <class T> DL_HD bool operator==(const Vec3<T>& a, const Vec3<T>& b) {
 }
 template <class T> DL_HD T dot(const Vec3<T>& a, const Vec3<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 template <class T> DL_HD T norm(const Vec3<T>& a) { return std::sqrt(dot(a, a)); }
+template <class T> DL_HD T length(const Vec3<T>& a) { return norm(a); }  // GLSL's name
+// Conversion between precisions (also where a functional cast would be read as aggregate init).
+template <class U, class T> DL_HD Vec3<U> vec3_cast(const Vec3<T>& a) { return {U(a.x), U(a.y), U(a.z)}; }
+
+template <class T>
+DL_HD bool is_finite(T a) {
+#if defined(__CUDA_ARCH__)
+  return isfinite(a);
+#else
+  return std::isfinite(a);
+#endif
+}
 
 using Vec3f = Vec3<float>;
 using Vec3d = Vec3<double>;

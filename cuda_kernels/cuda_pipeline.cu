@@ -16,13 +16,14 @@
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
 #include "force_stage.hpp"
+#include "core/step_params.hpp"
 #include "kernels.cuh"
 
 namespace deformlab::cuda {
 namespace {
 
 using dev::Link;
-using dev::Scene;
+using dev::P;
 using dev::Spring;
 using dev::Stencil;
 using dev::Targets;
@@ -30,59 +31,6 @@ using dev::Targets;
 constexpr int kBlock = 256;  // threads per block of the one-dimensional kernels
 
 unsigned blocks_for(std::int64_t n) { return unsigned((n + kBlock - 1) / kBlock); }
-
-// The stencil of a grid model in the CPU's adjacency order. Node v's springs are ordered by
-// spring index, and the builder numbers springs by their lower end (in node order), then by
-// the half-stencil offset. So v first sees the springs whose lower end is v - o (for each
-// half-stencil offset o, by decreasing linear offset), then its own in half-stencil order.
-// Rest lengths: one per offset, the model's value for the first spring with that offset.
-Stencil make_stencil(const Model& m) {
-  struct Half {
-    int di, dj, dk, kind;
-    std::int64_t linear;
-    float rest;
-  };
-  // Offsets keyed by (di, dj, dk) themselves: distinct offsets can share a linear offset on
-  // narrow grids. Scanning stops once every offset of the builder's half stencil was seen.
-  const bool volume = m.nz > 1 || m.topology == Topology::lattice;
-  const std::size_t possible = volume ? 16 : 6;
-  std::vector<Half> half;
-  std::vector<bool> seen(9 * 9 * 9, false);
-  const std::int64_t nxy = std::int64_t(m.nx) * m.ny;
-  for (int e = 0; e < m.spring_count() && half.size() < possible; ++e) {
-    const int a = m.spring_i[e], b = m.spring_j[e];
-    const int di = b % m.nx - a % m.nx, dj = int((b / m.nx) % m.ny - (a / m.nx) % m.ny), dk = int(b / nxy - a / nxy);
-    const int key = ((dk + 4) * 9 + dj + 4) * 9 + di + 4;
-    if (seen[key]) continue;
-    seen[key] = true;
-    half.push_back({di, dj, dk, int(m.kind[e]), std::int64_t(b) - a, m.rest_length[e]});
-  }
-  // Own springs in the builder's stencil order: lexicographic in (dk, dj, di) for the
-  // neighbour offsets, then flexion (2,0,0), (0,2,0), (0,0,2).
-  auto stencil_rank = [](const Half& h) {
-    const bool flex = std::abs(h.di) == 2 || std::abs(h.dj) == 2 || std::abs(h.dk) == 2;
-    if (flex) return 1000 + (h.di == 2 ? 0 : h.dj == 2 ? 1 : 2);
-    return ((h.dk + 1) * 3 + (h.dj + 1)) * 3 + (h.di + 1);
-  };
-  std::vector<Half> own = half, in = half;
-  std::stable_sort(own.begin(), own.end(), [&](const Half& a, const Half& b) { return stencil_rank(a) < stencil_rank(b); });
-  std::stable_sort(in.begin(), in.end(), [](const Half& a, const Half& b) { return a.linear > b.linear; });
-  Stencil st{};
-  auto put = [&](const Half& h, int sign) {
-    int& count = st.count;
-    if (count >= dev::kMaxStencil) throw std::logic_error("grid stencil larger than the kernels' limit");
-    st.di[count] = std::int8_t(sign * h.di);
-    st.dj[count] = std::int8_t(sign * h.dj);
-    st.dk[count] = std::int8_t(sign * h.dk);
-    st.rest[count] = h.rest;
-    st.k[count] = m.stiffness[h.kind];
-    st.kd[count] = m.damping[h.kind];
-    ++count;
-  };
-  for (const auto& h : in) put(h, -1);
-  for (const auto& h : own) put(h, +1);
-  return st;
-}
 
 // Throws std::invalid_argument when the tile is not a block shape or the grid exceeds the
 // launch limits with it.
@@ -101,42 +49,17 @@ void check_tile(const Model& m, const Tile& t) {
 // CUDA pipeline and, on its own, the force stage of the hybrid pipelines.
 class ForceKernels {
  public:
-  ForceKernels(const Model& m, const Params& p, const Options& o) : model_(m), o_(o) {
-    grid_ = m.topology != Topology::general;
-    scene_.n = m.node_count();
-    scene_.nx = m.nx; scene_.ny = m.ny; scene_.nz = std::max(1, m.nz);
-    for (int k = 0; k < kSpringKinds; ++k) { scene_.k[k] = m.stiffness[k]; scene_.kd[k] = m.damping[k]; }
+  ForceKernels(const Model& m, const Params& p, const Options& o)
+      : model_(m), o_(o), sp_(step_params<float>(m, p)) {
     damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
-    scene_.gravity = p.gravity; scene_.wind = p.wind;
-    scene_.c = p.damping; scene_.dt = p.dt;
-    if (p.drag.active()) {
-      scene_.drag_node = p.drag.node;
-      scene_.drag_hard = !p.drag.as_spring;
-      scene_.drag_k = p.drag.stiffness;
-    }
-    scene_.has_ground = p.ground.has_value();
-    scene_.ground = p.ground.value_or(0.f);
-    if (!p.spheres.empty()) {
-      std::vector<float4> sp;
-      for (const auto& s : p.spheres) sp.push_back(make_float4(s.center.x, s.center.y, s.center.z, s.radius));
-      upload(spheres_, sp, "uploading the sphere colliders");
-      scene_.sphere_count = int(sp.size());
-      scene_.spheres = spheres_.get();
-    }
-
-    if (grid_) {
-      stencil_ = make_stencil(m);
-      const int full = scene_.nz > 1 ? dev::kMaxStencil : 12;
-      canonical_ = stencil_.count == full;
-      for (int e = 0; e < stencil_.count && canonical_; ++e) {
-        const dev::Offset o = dev::canonical_offset(full, e);
-        canonical_ = o.di == stencil_.di[e] && o.dj == stencil_.dj[e] && o.dk == stencil_.dk[e];
-      }
+    if (m.grid()) {
+      const auto entries = stencil_entries<float>(m);
+      std::copy(entries.begin(), entries.end(), stencil_.e);
     } else if (o_.variant != Variant::scatter) {
       std::vector<Link> links(m.adj_node.size());
       for (std::size_t e = 0; e < links.size(); ++e) {
         const int sp = m.adj_spring[e];
-        links[e] = {m.adj_node[e], int(m.kind[sp]), m.rest_length[sp], 0};
+        links[e] = {m.adj_node[e], m.rest_length[sp], m.spring_k(sp), m.spring_kd(sp)};
       }
       upload(offset_, m.adj_offset, "uploading the adjacency offsets");
       upload(links_, links, "uploading the adjacency");
@@ -147,25 +70,26 @@ class ForceKernels {
   // acc = a(x, v) for every node, queued on `stream`.
   void forces(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
     if (o_.variant == Variant::scatter) {
-      check(cudaMemsetAsync(acc, 0, std::size_t(scene_.n) * sizeof(float4), stream), "clearing the force sums");
+      check(cudaMemsetAsync(acc, 0, std::size_t(sp_.node_count) * sizeof(float4), stream), "clearing the force sums");
       const std::int64_t s = std::int64_t(springs_.size());
       if (s > 0) {
-        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream>>>(scene_, springs_.get(), s, x, v, acc);
+        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream>>>(springs_.get(), s, x, v, acc);
         check_launch("launching the scatter kernel");
       }
-      dev::scatter_finish<<<blocks_for(scene_.n), kBlock, 0, stream>>>(scene_, x, v, acc, target);
+      dev::scatter_finish<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, x, v, acc, target);
       check_launch("launching the scatter finishing kernel");
       return;
     }
-    if (!grid_) {
-      dev::force_csr<<<blocks_for(scene_.n), kBlock, 0, stream>>>(scene_, offset_.get(), links_.get(), x, v, acc, target);
+    if (!model_.grid()) {
+      dev::force_csr<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, offset_.get(), links_.get(), x, v, acc,
+                                                                        target);
       check_launch("launching the CSR gather force kernel");
       return;
     }
     const bool tiled = o_.variant == Variant::tiled;
-    with_grid_flags([&](auto n, auto damped, auto canonical) {
-      if (tiled) launch_force_grid<n(), damped(), canonical(), true>(x, v, acc, target, stream);
-      else launch_force_grid<n(), damped(), canonical(), false>(x, v, acc, target, stream);
+    with_grid_flags([&](auto n, auto damped) {
+      if (tiled) launch_force_grid<n(), damped(), true>(x, v, acc, target, stream);
+      else launch_force_grid<n(), damped(), false>(x, v, acc, target, stream);
     });
   }
 
@@ -179,36 +103,33 @@ class ForceKernels {
   void upload_springs() {
     const Model& m = model_;
     std::vector<Spring> sp(m.spring_count());
-    for (int e = 0; e < m.spring_count(); ++e) sp[e] = {m.spring_i[e], m.spring_j[e], int(m.kind[e]), m.rest_length[e]};
+    for (int e = 0; e < m.spring_count(); ++e)
+      sp[e] = {m.spring_i[e], m.spring_j[e], m.rest_length[e], m.spring_k(e), m.spring_kd(e)};
     require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
     upload(springs_, sp, "uploading the spring list");
   }
   dim3 grid_blocks() const {
-    return dim3(unsigned((scene_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((scene_.ny + o_.tile.y - 1) / o_.tile.y),
-                unsigned(scene_.nz));
+    return dim3(unsigned((sp_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((sp_.ny + o_.tile.y - 1) / o_.tile.y),
+                unsigned(sp_.nz));
   }
   dim3 grid_threads() const { return dim3(unsigned(o_.tile.x), unsigned(o_.tile.y), 1); }
 
-  // Calls f(N, Damped, Canonical) with the grid kernels' compile-time flags for this model.
+  // Calls f(N, Damped) with the grid kernels' compile-time flags for this model.
   template <class F>
   void with_grid_flags(F&& f) const {
     using std::bool_constant;
     using std::integral_constant;
-    auto canon = [&](auto n, auto damped) {
-      if (canonical_) f(n, damped, bool_constant<true>{});
-      else f(n, damped, bool_constant<false>{});
-    };
     auto damp = [&](auto n) {
-      if (damped_) canon(n, bool_constant<true>{});
-      else canon(n, bool_constant<false>{});
+      if (damped_) f(n, bool_constant<true>{});
+      else f(n, bool_constant<false>{});
     };
-    if (scene_.nz > 1) damp(integral_constant<int, dev::kMaxStencil>{});
-    else damp(integral_constant<int, 12>{});
+    if (model_.volume()) damp(integral_constant<int, kLatticeStencil>{});
+    else damp(integral_constant<int, kClothStencil>{});
   }
 
-  template <int N, bool Damped, bool Canonical, bool Tiled>
+  template <int N, bool Damped, bool Tiled>
   void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
-    const auto kernel = dev::force_grid<N, Damped, Canonical, Tiled>;
+    const auto kernel = dev::force_grid<N, Damped, Tiled>;
     std::size_t shared = 0;
     if (Tiled) {
       const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
@@ -218,33 +139,30 @@ class ForceKernels {
         check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
               "raising the tiled kernel's shared-memory limit");
     }
-    kernel<<<grid_blocks(), grid_threads(), shared, stream>>>(scene_, stencil_, x, v, acc, target);
+    kernel<<<grid_blocks(), grid_threads(), shared, stream>>>(sp_, stencil_, x, v, acc, target);
     check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
   }
 
   const Model& model_;
   Options o_;
-  bool grid_ = false, damped_ = false, canonical_ = false;
-  Scene scene_;
+  bool damped_ = false;
+  dev::StepParams sp_;
   Stencil stencil_{};
-  Buffer<float4> spheres_;
   Buffer<int> offset_;
   Buffer<Link> links_;
   Buffer<Spring> springs_;
 };
 
-struct DispOp {  // |x_new - x_old|, +inf where anything is not finite
+struct DispOp {  // the stop rule's term of node i (infinite where the state is not finite)
   const float4* x;
   const float4* x_old;
   const float4* v;
   __device__ float operator()(int i) const {
-    const float d = norm(dev::xyz(x[i]) - dev::xyz(x_old[i]));
-    const float4 w = v[i];
-    const bool finite = isfinite(d) && isfinite(w.x) && isfinite(w.y) && isfinite(w.z);
-    return finite ? d : INFINITY;
+    return P::displacement(dev::xyz(x[i]), dev::xyz(x_old[i]), dev::xyz(v[i]));
   }
 };
 
+using PD = Physics<double>;
 __host__ __device__ Vec3d widen(const Vec3f& a) { return {a.x, a.y, a.z}; }
 
 struct NodeEnergy {
@@ -253,13 +171,10 @@ struct NodeEnergy {
 struct NodeEnergyOp {
   const float4* x;
   const float4* v;
-  Vec3d g, wind;
+  PD::StepParams sp;
   __device__ NodeEnergy operator()(int i) const {
     const float4 x4 = x[i];
-    if (x4.w == 0.f) return {0.0, 0.0};
-    const double mass = 1.0 / x4.w;
-    const Vec3d vd = widen(dev::xyz(v[i])), xd = widen(dev::xyz(x4));
-    return {0.5 * mass * dot(vd, vd), -dot(g * mass + wind, xd)};
+    return {PD::kinetic_energy(x4.w, widen(dev::xyz(v[i]))), PD::field_energy(sp, x4.w, widen(dev::xyz(x4)))};
   }
 };
 struct AddNodeEnergy {
@@ -270,11 +185,9 @@ struct AddNodeEnergy {
 struct SpringEnergyOp {
   const Spring* springs;
   const float4* x;
-  double k[3];
   __device__ double operator()(std::int64_t e) const {
     const Spring s = springs[e];
-    const double stretch = norm(widen(dev::xyz(x[s.i])) - widen(dev::xyz(x[s.j]))) - s.rest;
-    return 0.5 * (s.kind == 0 ? k[0] : s.kind == 1 ? k[1] : k[2]) * stretch * stretch;
+    return PD::spring_energy(widen(dev::xyz(x[s.i])), widen(dev::xyz(x[s.j])), s.k, s.rest);
   }
 };
 
@@ -328,20 +241,20 @@ class Impl final : public CudaPipeline, private ForceKernels {
     s.t = t_;
     s.x = download(x_[cur_]);
     s.v = download(v_[cur_]);
-    if (sched_.integrator == Integrator::verlet && has_prev_) s.x_prev = download(x_[1 - cur_]);
+    if (sched_.rule == UpdateRule::verlet && has_prev_) s.x_prev = download(x_[1 - cur_]);
     return s;
   }
 
   void step() override {
     // Profiled steps run pass by pass (a graph replay has no spans).
-    const bool replay = !prof_ && o_.graphs && time_invariant() && !(sched_.integrator == Integrator::verlet && !has_prev_);
+    const bool replay = !prof_ && o_.graphs && time_invariant() && !(sched_.rule == UpdateRule::verlet && !has_prev_);
     if (replay) {
       if (!graph_[cur_]) capture(cur_);
       check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");
     } else {
       enqueue_step();
     }
-    if (sched_.integrator == Integrator::verlet) has_prev_ = true;
+    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
     t_ += p_.dt;
     stepped_ = true;
@@ -361,9 +274,9 @@ class Impl final : public CudaPipeline, private ForceKernels {
     if (!springs_.get() && model_.spring_count() > 0) upload_springs();
     const NodeEnergy ne = thrust::transform_reduce(
         thrust::cuda::par.on(stream_), thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
-        NodeEnergyOp{x_[cur_].get(), v_[cur_].get(), widen(p_.gravity), widen(p_.wind)}, NodeEnergy{0.0, 0.0},
+        NodeEnergyOp{x_[cur_].get(), v_[cur_].get(), step_params<double>(model_, p_)}, NodeEnergy{0.0, 0.0},
         AddNodeEnergy{});
-    SpringEnergyOp op{springs_.get(), x_[cur_].get(), {model_.stiffness[0], model_.stiffness[1], model_.stiffness[2]}};
+    SpringEnergyOp op{springs_.get(), x_[cur_].get()};
     const double se = model_.spring_count() == 0
                           ? 0.0
                           : thrust::transform_reduce(thrust::cuda::par.on(stream_),
@@ -449,15 +362,17 @@ class Impl final : public CudaPipeline, private ForceKernels {
   const float4* slot_v(int k) const { return k == 0 ? v_[cur_].get() : sv_[k - 1].get(); }
 
   void enqueue_step() {
-    if (fused_) return timed(span::force_update, [&] { fused_step(); });
+    if (fused_) return timed(span::force_update, [&] { one_pass(true); });
     for (const Pass& pass : sched_.passes) {
       switch (pass.op) {
         case Pass::Op::force:
           timed(span::force, [&] { force_pass(pass.src, pass.acc, targets(pass.time_fraction).force); });
           break;
-        case Pass::Op::stage: timed(span::update, [&] { stage_pass(pass); }); break;
-        case Pass::Op::combine: timed(span::update, [&] { combine_pass(pass); }); break;
-        case Pass::Op::fused: timed(span::update, [&] { update_pass(); }); break;
+        case Pass::Op::combine:
+          if (sched_.single_pass()) timed(span::update, [&] { one_pass(false); });
+          else timed(span::update, [&] { combine_pass(pass); });
+          break;
+        case Pass::Op::update: timed(span::update, [&] { one_pass(false); }); break;
         case Pass::Op::solve: throw std::logic_error("solve pass on a CUDA pipeline");
       }
     }
@@ -490,31 +405,41 @@ class Impl final : public CudaPipeline, private ForceKernels {
     forces(slot_x(src), slot_v(src), acc_[slot].get(), target, stream_);
   }
 
-  template <Integrator I>
-  void update_as() {
-    const int nxt = 1 - cur_;
-    dev::update<I><<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x_[cur_].get(), v_[cur_].get(), acc_[0].get(),
-                                                           x_[nxt].get(), has_prev_, x_[nxt].get(), v_[nxt].get(),
-                                                           targets(0).end);
-    check_launch("launching the update kernel");
+  // The result of a one-force-pass schedule: the update kernel after a force pass, or with
+  // `fused` forces, update and constraints in one kernel.
+  void one_pass(bool fused) {
+    switch (sched_.rule) {
+      case UpdateRule::runge_kutta: return one_pass_as<RULE_RUNGE_KUTTA>(fused);
+      case UpdateRule::semi_implicit_euler: return one_pass_as<RULE_SEMI_IMPLICIT_EULER>(fused);
+      case UpdateRule::verlet: return one_pass_as<RULE_VERLET>(fused);
+      case UpdateRule::backward_euler: throw std::logic_error("one-pass update for backward Euler");
+    }
   }
-  void update_pass() {
-    switch (sched_.integrator) {
-      case Integrator::explicit_euler: return update_as<Integrator::explicit_euler>();
-      case Integrator::semi_implicit_euler: return update_as<Integrator::semi_implicit_euler>();
-      case Integrator::verlet: return update_as<Integrator::verlet>();
-      default: throw std::logic_error("one-pass update for a multi-pass integrator");
+  template <int Rule>
+  void one_pass_as(bool fused) {
+    const int nxt = 1 - cur_;
+    const float w = float(sched_.weight());
+    const float4 *x = x_[cur_].get(), *v = v_[cur_].get(), *xp = x_[nxt].get();
+    float4 *xo = x_[nxt].get(), *vo = v_[nxt].get();
+    const Targets tg = targets(0);
+    if (!fused) {
+      dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), xp, has_prev_, xo, vo,
+                                                                tg.end);
+      check_launch("launching the update kernel");
+    } else if (!model_.grid()) {
+      dev::fused_csr<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp,
+                                                                   has_prev_, xo, vo, tg);
+      check_launch("launching the fused CSR step kernel");
+    } else {
+      with_grid_flags([&](auto n, auto damped) {
+        dev::fused_grid<n(), damped(), Rule>
+            <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg);
+      });
+      check_launch("launching the fused step kernel");
     }
   }
 
-  void stage_pass(const Pass& pass) {
-    const float h = float(pass.coef * p_.dt);
-    dev::stage<<<blocks_for(n_), kBlock, 0, stream_>>>(n_, h, x_[cur_].get(), v_[cur_].get(), slot_v(pass.src),
-                                                       acc_[pass.acc].get(), sx_[pass.dst - 1].get(),
-                                                       sv_[pass.dst - 1].get());
-    check_launch("launching the stage kernel");
-  }
-
+  // A stage state or the step's result from the slopes with a non-zero weight.
   void combine_pass(const Pass& pass) {
     dev::Terms terms{};
     for (int k = 0; k < int(pass.weights.size()); ++k) {
@@ -524,41 +449,13 @@ class Impl final : public CudaPipeline, private ForceKernels {
       terms.weight[terms.count] = float(pass.weights[k]);
       ++terms.count;
     }
+    const bool result = pass.dst == Pass::kResult;
     const int nxt = 1 - cur_;
-    dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, x_[cur_].get(), v_[cur_].get(), terms,
-                                                         x_[nxt].get(), v_[nxt].get(), targets(0).end);
+    float4* xo = result ? x_[nxt].get() : sx_[pass.dst - 1].get();
+    float4* vo = result ? v_[nxt].get() : sv_[pass.dst - 1].get();
+    dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, result, xo, vo,
+                                                         targets(0).end);
     check_launch("launching the combine kernel");
-  }
-
-  template <int N, bool Damped, bool Canonical, Integrator I>
-  void launch_fused_grid(const Targets& tg) {
-    const int nxt = 1 - cur_;
-    dev::fused_grid<N, Damped, Canonical, I><<<grid_blocks(), grid_threads(), 0, stream_>>>(
-        scene_, stencil_, x_[cur_].get(), v_[cur_].get(), x_[nxt].get(), has_prev_, x_[nxt].get(), v_[nxt].get(), tg);
-    check_launch("launching the fused step kernel");
-  }
-  template <Integrator I>
-  void fused_as() {
-    const Targets tg = targets(0);
-    if (!grid_) {
-      const int nxt = 1 - cur_;
-      dev::fused_csr<I><<<blocks_for(n_), kBlock, 0, stream_>>>(scene_, offset_.get(), links_.get(), x_[cur_].get(),
-                                                                v_[cur_].get(), x_[nxt].get(), has_prev_,
-                                                                x_[nxt].get(), v_[nxt].get(), tg);
-      check_launch("launching the fused CSR step kernel");
-    } else {
-      with_grid_flags([&](auto n, auto damped, auto canonical) {
-        launch_fused_grid<n(), damped(), canonical(), I>(tg);
-      });
-    }
-  }
-  void fused_step() {
-    switch (sched_.integrator) {
-      case Integrator::explicit_euler: return fused_as<Integrator::explicit_euler>();
-      case Integrator::semi_implicit_euler: return fused_as<Integrator::semi_implicit_euler>();
-      case Integrator::verlet: return fused_as<Integrator::verlet>();
-      default: throw std::logic_error("fused step for a multi-pass integrator");
-    }
   }
 
   Params p_;

@@ -56,7 +56,7 @@ std::int64_t bytes_needed(const Model& m, Integrator i, const Options& o) {
 double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
   const Schedule s = make_schedule(i);
   const double f4 = 16, springs_per_node = m.node_count() ? double(m.spring_count()) / m.node_count() : 0;
-  const double prev = i == Integrator::verlet ? f4 : 0;
+  const double prev = s.rule == UpdateRule::verlet ? f4 : 0;
   const double links = m.topology == Topology::general ? 4 + 2 * springs_per_node * 16 : 0;
   // Force pass: gather reads (x, v) and writes a. Scatter: clears the sums, reads every
   // spring once and (x, v), adds into the sums, then reads them with (x, v) to write a.
@@ -68,17 +68,11 @@ double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
   }
   double b = 0;
   for (const Pass& p : s.passes) {
-    switch (p.op) {
-      case Pass::Op::force: b += force; break;
-      case Pass::Op::stage: b += 6 * f4; break;  // x0, v0, v_src, a in; x, v out
-      case Pass::Op::combine: {
-        int terms = 0;
-        for (double w : p.weights) terms += w != 0.0;
-        b += 2 * f4 + terms * 2 * f4 + 2 * f4;
-        break;
-      }
-      default: break;
-    }
+    if (p.op == Pass::Op::force) b += force;
+    if (p.op != Pass::Op::combine) continue;
+    int terms = 0;  // x0, v0 and the slopes (v_j, a_j) of non-zero weight in; x, v out
+    for (double w : p.weights) terms += w != 0.0;
+    b += 2 * f4 + terms * 2 * f4 + 2 * f4;
   }
   return b;
 }

@@ -17,7 +17,7 @@ class ComputePipeline final : public GlPipeline {
       : GlPipeline(s, forces ? "hybrid-compute" : "glsl-compute", forces) {
     GLint blocks = 0;
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
-    const int need = forces ? 12 : 11;
+    const int need = forces ? 9 : 8;
     if (blocks < need)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
     GLint max_x = 0, max_y = 0;
@@ -31,18 +31,19 @@ class ComputePipeline final : public GlPipeline {
   }
 
  private:
-  Program make_program(PassKind, const std::string& defines) override {
+  Program make_program(int, const std::string& defines) override {
     return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines);
   }
 
   void run_pass(GLuint program, const PassIO& io) override {
-    const NodeBuffer* in[7] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v, io.acc_x, io.acc_v};
-    for (int k = 0; k < 7; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->id());
-    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7 + k, io.out[k]->id());
-    if (io.forces_acc) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, io.forces_acc->id());
+    const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
+    for (int k = 0; k < 5; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->id());
+    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5 + k, io.out[k]->id());
+    if (io.forces_acc) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, io.forces_acc->id());
     glUseProgram(program);
     glDispatchCompute(groups_[0], groups_[1], 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    // Later passes read this one's outputs as storage buffers and (earlier stages) as textures.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     glUseProgram(0);
   }
 

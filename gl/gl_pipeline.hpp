@@ -12,15 +12,6 @@
 
 namespace deformlab::gl {
 
-// The half stencil of a grid or lattice model when its springs are exactly every in-bounds
-// pair of a few grid offsets, each offset of one kind and one rest length up to the rounding
-// of the float rest positions (then shaders find neighbours by arithmetic), else empty.
-struct StencilOffset {
-  int di, dj, dk, kind;
-  float rest;
-};
-std::vector<StencilOffset> grid_stencil(const Model& m);
-
 // Forces from outside the GL layer (the hybrid pipelines): another stage writes each node's
 // acceleration into a GL buffer that the update passes read instead of evaluating forces.
 enum class NodeRole { state, accelerations };
@@ -52,22 +43,25 @@ class GlPipeline : public Pipeline {
   // (without an external force stage, which times the passes itself).
   void set_profiler(Profiler* p) override;
   // "grid arithmetic" or "adjacency buffer": how the shaders find a node's springs.
-  std::string neighbour_mode() const { return stencil_.empty() ? "adjacency buffer" : "grid arithmetic"; }
+  std::string neighbour_mode() const { return m_.grid() ? "grid arithmetic" : "adjacency buffer"; }
 
  protected:
-  enum class PassKind { explicit_euler, semi_implicit_euler, verlet, stage, combine };
+  // A GPU pass: the forces at stage `stage`, then (see shaders/sim.glsl) the step's result by
+  // the one-pass rule (one), the next stage state (stage) or the step's result (result).
+  enum class PassKind { one, stage, result };
   struct NodeBuffer {
     Buffer buf;           // owned here, or
     GLuint external = 0;  // owned by the external force stage
     Texture tex;          // texture buffer view (RGBA32F)
     GLuint id() const { return external ? external : buf.id(); }
   };
-  // What one pass reads and writes. s0: the current state (and Verlet's previous
-  // positions); src: the state the forces are evaluated at; acc: the running sums.
+  // What one pass reads and writes (besides the earlier stages' slopes, bound as textures
+  // for both pipelines). s0: the current state (and Verlet's previous positions); src: the
+  // state the forces are evaluated at.
   struct PassIO {
     int set;  // index of the current state set (VAO set of the TF pipeline)
-    const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v, *acc_x, *acc_v;
-    std::array<const NodeBuffer*, 4> out;
+    const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v;
+    std::array<const NodeBuffer*, 3> out;
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from the external force stage, else null
   };
@@ -76,43 +70,42 @@ class GlPipeline : public Pipeline {
   GlPipeline(const PipelineSetup& s, std::string name, ExternalForces* forces = nullptr);
   // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
   void init();
-  // `defines` selects the pass kind and the neighbour mode (see shaders/sim.glsl).
-  virtual Program make_program(PassKind kind, const std::string& defines) = 0;
+  // `defines` selects the pass kind, its stage, the update rule and the neighbour mode (see
+  // shaders/sim.glsl); `outputs` values per node are written.
+  virtual Program make_program(int outputs, const std::string& defines) = 0;
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
   virtual void on_set_state() {}
-  void bind_model_textures() const;  // adjacency texture buffers (general models)
 
   int n_ = 0;
   const std::string name_;
   ExternalForces* const forces_;
   NodeBuffer forces_acc_;  // what the external force stage writes
-  std::array<NodeBuffer, 2> x_, v_, xp_;      // state sets, ping-pong (xp_: Verlet)
-  std::array<NodeBuffer, 2> sx_, sv_, ax_, av_;  // stage states and running sums, ping-pong
+  std::array<NodeBuffer, 2> x_, v_, xp_;  // state sets, ping-pong (xp_: Verlet)
+  // Runge-Kutta stages: sx_[k], sv_[k] the state of stage k + 1, sa_[k] the acceleration at stage k.
+  std::array<NodeBuffer, kMaxStages - 1> sx_, sv_, sa_;
 
  private:
   struct GpuPass {
     PassKind kind;
-    int src_slot;  // stage slot the forces are evaluated at; -1: the current state
-    int out_slot;  // stage slot written (stage passes)
-    float h, weight;
+    int stage;
     double time_fraction;
-    bool first;
-  };
-  struct PassProgram {
+    std::array<float, kMaxStages> weights;  // of the slopes 0..stage (one: b_0)
     Program prog;
-    GLint drag_force_target, drag_next, stage_h, weight, first, has_prev;
+    GLint drag_force_target, drag_next, has_prev;
   };
+  void make_buffers(const Schedule& s);
+  void upload_params();
+  void upload_adjacency();
   void plan(const Schedule& s);
+  void bind_textures(int stage) const;  // earlier stages' slopes and the adjacency
 
   const Model& m_;
   const Params p_;
-  const Integrator integrator_;
-  std::vector<StencilOffset> stencil_;
+  const UpdateRule rule_;
   std::vector<GpuPass> passes_;
-  std::array<PassProgram, 5> programs_;
-  Buffer params_ubo_, adj_offset_, adj_entry_, adj_rest_, result_;
-  Texture adj_offset_tex_, adj_entry_tex_, adj_rest_tex_;
+  Buffer params_ubo_, adj_offset_, links_, result_;
+  Texture adj_offset_tex_, links_tex_;
   Program reduce_, copy_;
   GLint reduce_n_ = -1, copy_n_ = -1;
   Profiler* prof_ = nullptr;

@@ -15,7 +15,7 @@ class TfPipeline final : public GlPipeline {
       : GlPipeline(s, forces ? "hybrid" : "glsl-tf", forces) {
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
-    if (separate < 4) throw std::invalid_argument(name_ + " needs 4 separate transform feedback buffers");
+    if (separate < 3) throw std::invalid_argument(name_ + " needs 3 separate transform feedback buffers");
     for (int k = 0; k < 2; ++k) {
       GLuint id = 0;
       glGenVertexArrays(1, &id);
@@ -35,15 +35,14 @@ class TfPipeline final : public GlPipeline {
   }
 
  private:
-  Program make_program(PassKind kind, const std::string& defines) override {
-    static const std::vector<std::string> out[] = {{"o0", "o1"}, {"o0", "o1", "o2"}, {"o0", "o1", "o2", "o3"}};
-    const int which = kind == PassKind::stage ? 2 : kind == PassKind::verlet ? 1 : 0;
-    return gl::make_program({{GL_VERTEX_SHADER, "step.vert"}}, defines, out[which]);
+  Program make_program(int outputs, const std::string& defines) override {
+    const std::vector<std::string> out = {"o0", "o1", "o2"};
+    return gl::make_program({{GL_VERTEX_SHADER, "step.vert"}}, defines, {out.begin(), out.begin() + outputs});
   }
 
   // One transform feedback object per set of output buffers, made on first use.
   GLuint feedback(const PassIO& io) {
-    std::array<GLuint, 4> key{};
+    std::array<GLuint, 3> key{};
     for (int k = 0; k < io.outputs; ++k) key[k] = io.out[k]->id();
     auto& tfo = tfos_[key];
     if (!tfo) {
@@ -59,13 +58,13 @@ class TfPipeline final : public GlPipeline {
 
   void run_pass(GLuint program, const PassIO& io) override {
     const GLuint tfo = feedback(io);
-    const GLuint tex[4] = {io.src_x->tex.id(), io.src_v->tex.id(), io.acc_x->tex.id(), io.acc_v->tex.id()};
-    for (int k = 0; k < 4; ++k) {
+    const GLuint tex[2] = {io.src_x->tex.id(), io.src_v->tex.id()};
+    for (int k = 0; k < 2; ++k) {
       glActiveTexture(GL_TEXTURE0 + k);
       glBindTexture(GL_TEXTURE_BUFFER, tex[k]);
     }
     if (io.forces_acc) {
-      glActiveTexture(GL_TEXTURE7);
+      glActiveTexture(GL_TEXTURE10);
       glBindTexture(GL_TEXTURE_BUFFER, io.forces_acc->tex.id());
     }
     glActiveTexture(GL_TEXTURE0);
@@ -91,7 +90,7 @@ class TfPipeline final : public GlPipeline {
   void on_set_state() override { last_tfo_ = 0; }
 
   std::array<VertexArray, 2> vao_;
-  std::map<std::array<GLuint, 4>, TransformFeedback> tfos_;
+  std::map<std::array<GLuint, 3>, TransformFeedback> tfos_;
   GLuint last_tfo_ = 0;
 };
 

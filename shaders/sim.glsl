@@ -1,173 +1,98 @@
-// One mass-spring step for one node, shared by the transform-feedback (step.vert) and the
-// compute (step.comp) pipelines: the arithmetic of core/forces.hpp and core/cpu_backend.cpp.
+// One pass of a mass-spring step for one node, shared by the transform-feedback (step.vert)
+// and the compute (step.comp) pipelines. The physics is core/node_physics.h; this file binds it
+// to GLSL and to the GL pipelines' buffers, and runs one pass of the integrator's schedule.
 // The including shader defines, before this file:
 //   vec4 src_x(int j), src_v(int j)  the state the forces are evaluated at (x.w: inverse mass)
-//   vec4 acc_x(int i), acc_v(int i)  the running sums of a multi-pass combine
-// and the host defines PASS (one of the PASS_* below) and TOPOLOGY_GRID or TOPOLOGY_GENERAL.
+// and the host defines PASS (one of the PASS_* below), STAGE (the pass's stage, 0..3),
+// RULE (node_physics.h's RULE_*) and TOPOLOGY_GRID or TOPOLOGY_GENERAL.
 // With EXTERNAL_FORCES (the hybrid pipelines) another API's force pass wrote each node's
 // acceleration, which the including shader reads as vec4 forces_acc(int i).
 
-#define PASS_EXPLICIT_EULER 0
-#define PASS_SEMI_IMPLICIT_EULER 1
-#define PASS_VERLET 2
-#define PASS_STAGE 3    // forces at a stage state, the next stage state and the running sums
-#define PASS_COMBINE 4  // forces at the last stage, the combined step and the constraints
+#define real float
+#define DL_FN
+#define CREF(T) T
+#define OUT(T) out T
+#define INOUT(T) inout T
+#define VEC3(a, b, c) vec3(a, b, c)
+#define DL_FINITE(a) ((floatBitsToUint(a) & 0x7f800000u) != 0x7f800000u)
+#define DL_INFINITY uintBitsToFloat(0x7f800000u)
+#include "node_physics.h"
 
-#define DRAG_NONE 0
-#define DRAG_HARD 1
-#define DRAG_SPRING 2
+#define PASS_ONE 0     // one force pass and the step's result: o0 = x', o1 = (v', displacement), o2 = x (Verlet)
+#define PASS_STAGE 1   // forces at stage STAGE, then stage STAGE+1: o0 = a, o1 = x, o2 = v
+#define PASS_RESULT 2  // forces at the last stage, then the step's result: o0 = x', o1 = (v', displacement)
 
-// Static for a run; layout mirrored by SimParams in gl/gl_pipeline.cpp.
-layout(std140, binding = 0) uniform SimParams {
-  ivec4 dims;          // nx, ny, nz, node count
-  vec4 gravity_dt;     // gravity (m/s^2), dt (s)
-  vec4 wind_damping;   // wind force (N), global damping c (N s/m)
-  vec4 stiffness;      // per spring kind (N/m); w: drag spring stiffness
-  vec4 spring_damping; // per spring kind (N s/m)
-  vec4 dt_terms;       // dt^2, dt^2/2, 1/dt, ground height
-  ivec4 flags;         // drag node, drag mode, has ground, sphere count
-  ivec4 stencil_size;  // x: offsets in the half stencil (grids)
-  vec4 spheres[8];     // centre, radius
-  ivec4 stencil[16];   // grid offset (di, dj, dk), spring kind
-  vec4 stencil_rest[16];  // x: rest length of the offset's springs (m)
+// Static for a run; mirrored by SimBlock in gl/gl_pipeline.cpp.
+layout(std140, binding = 0) uniform Sim {
+  StepParams params;
+  StencilEntry stencil[MAX_STENCIL];
 };
 
 uniform vec3 u_drag_force_target;  // spring drag: target at this pass's force time
 uniform vec3 u_drag_next;          // hard drag: target at t + dt
-uniform float u_stage_h;           // stage: coef * dt
-uniform float u_weight;            // combine weight of this pass's slope (0: not summed)
-uniform bool u_first;              // first pass of a multi-pass step: the sums start at zero
+uniform float u_weights[4];        // Runge-Kutta weights of the slopes 0..STAGE (PASS_ONE: b_0)
 uniform bool u_has_prev;           // Verlet: previous positions are valid
 
+// Earlier stages' slopes: velocities of stage states 1..3, accelerations of stages 0..2.
+layout(binding = 2) uniform samplerBuffer u_stage_v[3];
+layout(binding = 5) uniform samplerBuffer u_stage_a[3];
+
 #ifdef TOPOLOGY_GENERAL
-// Node -> incident springs (CSR): offsets [n+1]; entries (other node, spring kind) [2s]; rest lengths [2s].
-layout(binding = 4) uniform isamplerBuffer u_adj_offset;
-layout(binding = 5) uniform isamplerBuffer u_adj;
-layout(binding = 6) uniform samplerBuffer u_adj_rest;
+// Node -> incident springs (CSR): offsets [n+1]; links [2s]: (other node's bits, rest, k, kd).
+layout(binding = 8) uniform isamplerBuffer u_adj_offset;
+layout(binding = 9) uniform samplerBuffer u_links;
 #endif
 
-// f_i = -(k (|d| - l) + kd (v_i - v_j).u) u,  d = x_i - x_j; coincident nodes exert none.
-vec3 spring_force(vec3 xi, vec3 xj, vec3 vi, vec3 vj, float k, float kd, float rest) {
-  vec3 d = xi - xj;
-  float len = length(d);
-  if (len == 0.0) return vec3(0.0);
-  vec3 u = d * (1.0 / len);
-  float s = k * (len - rest) + kd * dot(vi - vj, u);
-  return u * (-s);
-}
-
-vec3 acceleration(int i, vec3 xi, vec3 vi, float w) {
-  if (w == 0.0 || (flags.y == DRAG_HARD && i == flags.x)) return vec3(0.0);
+vec3 springs_on(int i, vec3 xi, vec3 vi) {
   vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
-  // Neighbours by arithmetic: every offset of the half stencil, both ways.
-  ivec3 c = ivec3(i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y));
-  for (int s = 0; s < stencil_size.x; ++s) {
-    ivec4 o = stencil[s];
-    float k = stiffness[o.w], kd = spring_damping[o.w], rest = stencil_rest[s].x;
-    for (int sgn = -1; sgn <= 1; sgn += 2) {
-      ivec3 q = c + sgn * o.xyz;
-      if (all(greaterThanEqual(q, ivec3(0))) && all(lessThan(q, dims.xyz))) {
-        int j = (q.z * dims.y + q.y) * dims.x + q.x;
-        f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, k, kd, rest);
-      }
-    }
+  int ci = i % params.nx, cj = (i / params.nx) % params.ny, ck = i / (params.nx * params.ny);
+  for (int e = 0; e < params.stencil_count; ++e) {
+    int j = grid_neighbour(params, ci, cj, ck, stencil[e].di, stencil[e].dj, stencil[e].dk);
+    if (j >= 0) f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, stencil[e].k, stencil[e].kd, stencil[e].rest);
   }
 #else
   int end = texelFetch(u_adj_offset, i + 1).x;
   for (int e = texelFetch(u_adj_offset, i).x; e < end; ++e) {
-    ivec2 jk = texelFetch(u_adj, e).xy;
-    f += spring_force(xi, src_x(jk.x).xyz, vi, src_v(jk.x).xyz, stiffness[jk.y], spring_damping[jk.y],
-                      texelFetch(u_adj_rest, e).x);
+    vec4 l = texelFetch(u_links, e);
+    int j = floatBitsToInt(l.x);
+    f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, l.z, l.w, l.y);
   }
 #endif
-  if (flags.y == DRAG_SPRING && i == flags.x) f += (u_drag_force_target - xi) * stiffness.w;
-  return (f + wind_damping.xyz - vi * wind_damping.w) * w + gravity_dt.xyz;
+  return f;
 }
 
-// Pins, the hard drag, the ground plane and the spheres, after the update.
-void constrain(int i, vec3 x_old, float w, inout vec3 x, inout vec3 v) {
-  if (w == 0.0) {
-    x = x_old;
-    v = vec3(0.0);
-  } else if (flags.y == DRAG_HARD && i == flags.x) {
-    x = u_drag_next;
-    v = (x - x_old) * dt_terms.z;
-  } else {
-    if (flags.z != 0 && x.y < dt_terms.w) {
-      x.y = dt_terms.w;
-      if (v.y < 0.0) v.y = 0.0;
-    }
-    for (int s = 0; s < flags.w; ++s) {
-      vec3 d = x - spheres[s].xyz;
-      float len = length(d);
-      if (len >= spheres[s].w) continue;
-      vec3 n = len > 0.0 ? d * (1.0 / len) : vec3(0.0, 1.0, 0.0);
-      x = spheres[s].xyz + n * spheres[s].w;
-      float vn = dot(v, n);
-      if (vn < 0.0) v -= n * vn;
-    }
-  }
-}
-
-// |x - x_old|, or +inf when anything is not finite (tested on the bits, immune to fast math),
-// so that a max over nodes of the bit patterns flags divergence.
-float displacement(vec3 x, vec3 x_old, vec3 v) {
-  float d = length(x - x_old);
-  const uint e = 0x7f800000u;
-  uvec4 bits = floatBitsToUint(vec4(v, d)) & uvec4(e);
-  uvec3 xb = floatBitsToUint(x) & uvec3(e);
-  return (any(equal(bits, uvec4(e))) || any(equal(xb, uvec3(e)))) ? uintBitsToFloat(e) : d;
-}
-
-// The pass for node i from the current state (x0, v0) and, for Verlet, the previous
-// position xp. Outputs: o0 = position (w: inverse mass), o1 = velocity (w: displacement of
-// the step) on fused and combine passes; stage passes write the stage state to o0, o1 and
-// the running sums to o2, o3; Verlet writes the new previous position to o2.
-void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out vec4 o2, out vec4 o3) {
-  float w = x0.w, dt = gravity_dt.w;
+// The pass for node i from the current state (x0, v0) and, for Verlet, the previous position xp.
+void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out vec4 o2) {
+  float w = x0.w, dt = params.dt;
   vec3 xs = src_x(i).xyz, vs = src_v(i).xyz;
 #ifdef EXTERNAL_FORCES
   vec3 a = forces_acc(i).xyz;
 #else
-  vec3 a = acceleration(i, xs, vs, w);
+  vec3 a = node_fixed(params, i, w) ? vec3(0.0)
+                                    : node_acceleration(params, i, w, xs, vs, springs_on(i, xs, vs), u_drag_force_target);
 #endif
   vec3 x, v;
   o2 = vec4(0.0);
-  o3 = vec4(0.0);
-#if PASS == PASS_EXPLICIT_EULER
-  x = x0.xyz + v0.xyz * dt;
-  v = v0.xyz + a * dt;
-#elif PASS == PASS_SEMI_IMPLICIT_EULER
-  v = v0.xyz + a * dt;
-  x = x0.xyz + v * dt;
-#elif PASS == PASS_VERLET
-  vec3 s = u_has_prev ? (x0.xyz - xp.xyz) + a * dt_terms.x : v0.xyz * dt + a * dt_terms.y;
-  x = x0.xyz + s;
-  v = s * dt_terms.z;
+#if PASS == PASS_ONE
+  one_pass_update(RULE, u_weights[0], x0.xyz, v0.xyz, a, xp.xyz, u_has_prev, dt, x, v);
   o2 = x0;
 #else
-  vec3 sx = vec3(0.0), sv = vec3(0.0);
-  if (!u_first) {
-    sx = acc_x(i).xyz;
-    sv = acc_v(i).xyz;
-  }
-  if (u_weight != 0.0) {
-    sx += vs * u_weight;
-    sv += a * u_weight;
-  }
+  vec3 dx = vec3(0.0), dv = vec3(0.0);
+  if (STAGE > 0 && u_weights[0] != 0.0) add_slope(dx, dv, u_weights[0], v0.xyz, texelFetch(u_stage_a[0], i).xyz);
+  for (int j = 1; j < STAGE; ++j)
+    if (u_weights[j] != 0.0)
+      add_slope(dx, dv, u_weights[j], texelFetch(u_stage_v[j - 1], i).xyz, texelFetch(u_stage_a[j], i).xyz);
+  if (u_weights[STAGE] != 0.0) add_slope(dx, dv, u_weights[STAGE], vs, a);
+  rk_state(x0.xyz, v0.xyz, dx, dv, dt, x, v);
 #if PASS == PASS_STAGE
-  o0 = vec4(x0.xyz + vs * u_stage_h, w);
-  o1 = vec4(v0.xyz + a * u_stage_h, 0.0);
-  o2 = vec4(sx, 0.0);
-  o3 = vec4(sv, 0.0);
+  o0 = vec4(a, 0.0);
+  o1 = vec4(x, w);
+  o2 = vec4(v, 0.0);
   return;
-#else
-  x = x0.xyz + sx * dt;
-  v = v0.xyz + sv * dt;
 #endif
 #endif
-  constrain(i, x0.xyz, w, x, v);
+  constrain_node(params, i, w, x0.xyz, u_drag_next, x, v);
   o0 = vec4(x, w);
   o1 = vec4(v, displacement(x, x0.xyz, v));
 }

@@ -7,19 +7,14 @@ layout(std430, binding = 1) readonly buffer S0V { vec4 s0_v[]; };
 layout(std430, binding = 2) readonly buffer SP { vec4 s0_p[]; };   // Verlet: previous positions
 layout(std430, binding = 3) readonly buffer SrcX { vec4 src_x_[]; };  // forces evaluated here
 layout(std430, binding = 4) readonly buffer SrcV { vec4 src_v_[]; };
-layout(std430, binding = 5) readonly buffer AccX { vec4 acc_x_[]; };  // running sums
-layout(std430, binding = 6) readonly buffer AccV { vec4 acc_v_[]; };
-layout(std430, binding = 7) writeonly buffer O0 { vec4 out0[]; };
-layout(std430, binding = 8) writeonly buffer O1 { vec4 out1[]; };
-layout(std430, binding = 9) writeonly buffer O2 { vec4 out2[]; };
-layout(std430, binding = 10) writeonly buffer O3 { vec4 out3[]; };
+layout(std430, binding = 5) writeonly buffer O0 { vec4 out0[]; };
+layout(std430, binding = 6) writeonly buffer O1 { vec4 out1[]; };
+layout(std430, binding = 7) writeonly buffer O2 { vec4 out2[]; };
 
 vec4 src_x(int j) { return src_x_[j]; }
 vec4 src_v(int j) { return src_v_[j]; }
-vec4 acc_x(int i) { return acc_x_[i]; }
-vec4 acc_v(int i) { return acc_v_[i]; }
 #ifdef EXTERNAL_FORCES
-layout(std430, binding = 11) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
+layout(std430, binding = 8) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
 vec4 forces_acc(int i) { return forces_acc_[i]; }
 #endif
 
@@ -28,20 +23,17 @@ vec4 forces_acc(int i) { return forces_acc_[i]; }
 void main() {
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
   int i = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
-  if (i >= dims.w) return;
-#if PASS == PASS_VERLET
+  if (i >= params.node_count) return;
+#if PASS == PASS_ONE && RULE == RULE_VERLET
   vec4 xp = s0_p[i];
 #else
   vec4 xp = vec4(0.0);
 #endif
-  vec4 o0, o1, o2, o3;
-  node_pass(i, s0_x[i], s0_v[i], xp, o0, o1, o2, o3);
+  vec4 o0, o1, o2;
+  node_pass(i, s0_x[i], s0_v[i], xp, o0, o1, o2);
   out0[i] = o0;
   out1[i] = o1;
-#if PASS == PASS_VERLET
+#if PASS == PASS_STAGE || (PASS == PASS_ONE && RULE == RULE_VERLET)
   out2[i] = o2;
-#elif PASS == PASS_STAGE
-  out2[i] = o2;
-  out3[i] = o3;
 #endif
 }

@@ -7,20 +7,16 @@ layout(location = 2) in vec4 in_p;  // Verlet: previous position
 
 layout(binding = 0) uniform samplerBuffer u_src_x;  // state the forces are evaluated at
 layout(binding = 1) uniform samplerBuffer u_src_v;
-layout(binding = 2) uniform samplerBuffer u_acc_x;  // running sums (multi-pass)
-layout(binding = 3) uniform samplerBuffer u_acc_v;
 
 vec4 src_x(int j) { return texelFetch(u_src_x, j); }
 vec4 src_v(int j) { return texelFetch(u_src_v, j); }
-vec4 acc_x(int i) { return texelFetch(u_acc_x, i); }
-vec4 acc_v(int i) { return texelFetch(u_acc_v, i); }
 #ifdef EXTERNAL_FORCES
-layout(binding = 7) uniform samplerBuffer u_forces_acc;  // accelerations from the force stage
+layout(binding = 10) uniform samplerBuffer u_forces_acc;  // accelerations from the force stage
 vec4 forces_acc(int i) { return texelFetch(u_forces_acc, i); }
 #endif
 
 #include "sim.glsl"
 
-out vec4 o0, o1, o2, o3;
+out vec4 o0, o1, o2;
 
-void main() { node_pass(gl_VertexID, in_x, in_v, in_p, o0, o1, o2, o3); }
+void main() { node_pass(gl_VertexID, in_x, in_v, in_p, o0, o1, o2); }

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cpu_backend.hpp"
-#include "core/forces.hpp"
+#include "core/step_params.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 #include "tests/support/test_states.hpp"
@@ -14,8 +14,8 @@
 namespace deformlab::test {
 namespace {
 
-// Accelerations on the host with the formulas of core/forces.hpp, summed in the adjacency
-// order of the CPU pipeline.
+// Accelerations on the host with the per-node physics (core/node_physics.h), summed in
+// adjacency order.
 class HostForces final : public gl::ExternalForces {
  public:
   HostForces(const Model& m, const Params& p) : m_(m), p_(p) {}
@@ -31,18 +31,17 @@ class HostForces final : public gl::ExternalForces {
     gl::read_buffer(x, xs.size() * 4, xs.data());
     gl::read_buffer(v, vs.size() * 4, vs.data());
     auto at = [](const std::vector<float>& b, int i) { return Vec3f{b[4 * i], b[4 * i + 1], b[4 * i + 2]}; };
-    const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
-    const Vec3f target = spring_drag ? p_.drag.target(t) : Vec3f{};
+    using P = Physics<float>;
+    const P::StepParams sp = step_params<float>(m_, p_);
+    const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
     for (int i = 0; i < int(n); ++i) {
       const float w = m_.inv_mass[i];
-      if (w == 0.f) continue;
       Vec3f f{};
       for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
-        const int sp = m_.adj_spring[e], j = m_.adj_node[e], k = int(m_.kind[sp]);
-        f += spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), m_.stiffness[k], m_.damping[k], m_.rest_length[sp]);
+        const int s = m_.adj_spring[e], j = m_.adj_node[e];
+        f += P::spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), m_.spring_k(s), m_.spring_kd(s), m_.rest_length[s]);
       }
-      if (spring_drag && i == p_.drag.node) f += (target - at(xs, i)) * p_.drag.stiffness;
-      const Vec3f ai = acceleration(f, at(vs, i), w, p_.damping, p_.wind, p_.gravity);
+      const Vec3f ai = P::node_acceleration(sp, i, w, at(xs, i), at(vs, i), f, target);
       a[4 * i] = ai.x;
       a[4 * i + 1] = ai.y;
       a[4 * i + 2] = ai.z;

@@ -64,6 +64,7 @@ TEST_F(Order, EachIntegratorShowsItsOrder) {
       {Integrator::backward_euler, 1, {2e-4, 1e-4, 5e-5, 2.5e-5}},
       {Integrator::midpoint, 2, {8e-4, 4e-4, 2e-4, 1e-4}},
       {Integrator::verlet, 2, {8e-4, 4e-4, 2e-4, 1e-4}},
+      {Integrator::rk3, 3, {1.6e-3, 8e-4, 4e-4}},
       {Integrator::rk4, 4, {3.2e-3, 1.6e-3, 8e-4}},
   };
   for (const auto& c : cases) {

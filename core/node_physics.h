@@ -1,0 +1,185 @@
+// The per-node stages of a mass-spring step, written once for every backend: the CPU
+// pipelines and the CUDA kernels include it through core/physics.hpp (as static members of
+// Physics<Real>), the GLSL shaders through shaders/sim.glsl. It is therefore written in the
+// subset the three languages share. The includer defines:
+//   real, vec3               the scalar and 3-vector types (float / vec3 in GLSL)
+//   DL_FN                    a function's qualifiers (host + device in CUDA, static members in C++)
+//   CREF(T) OUT(T) INOUT(T)  parameter passing: const T& / T& in C++; T / out T / inout T in GLSL
+//   VEC3(x, y, z)            a vector from its components
+//   DL_FINITE(a)             whether a scalar is finite (immune to fast math in GLSL)
+//   DL_INFINITY              +infinity
+// No include guard: C++ includes it once per precision.
+
+#define DRAG_NONE 0
+#define DRAG_HARD 1    // the node is kinematic and sits on its target after every step
+#define DRAG_SPRING 2  // a spring of drag_stiffness pulls the node towards its target
+
+// Update rules (Schedule::rule): how a step's result is formed from its force passes.
+#define RULE_RUNGE_KUTTA 0         // s0 + dt sum_j b_j k_j, slopes k_j = (v_j, a_j)
+#define RULE_SEMI_IMPLICIT_EULER 1 // v' = v + dt a, x' = x + dt v'
+#define RULE_VERLET 2              // x' = 2x - x_prev + dt^2 a, v' = (x' - x) / dt
+
+#define ZERO3 VEC3(real(0), real(0), real(0))
+#define MAX_SPHERES 8
+#define MAX_STENCIL 32  // lattice: 6 structural + 20 shear + 6 flexion neighbours
+
+struct Sphere {
+  vec3 center;  // m
+  real radius;  // m
+};
+
+// What every node's step reads, constant for a run. For float this is also the std140 layout
+// of the GLSL uniform block (each vec3 is followed by a scalar, each row is 16 bytes).
+struct StepParams {
+  vec3 gravity;  // m/s^2
+  real dt;       // s
+  vec3 wind;     // N on every free node
+  real damping;  // global velocity damping c, N s/m
+  int drag_node;        // -1: none
+  int drag_mode;        // DRAG_*
+  real drag_stiffness;  // N/m (DRAG_SPRING)
+  int has_ground;       // 0 or 1
+  real ground;          // plane y = ground
+  int sphere_count;
+  int nx, ny;           // grid dimensions (node (i, j, k) = (k ny + j) nx + i)
+  int nz, node_count;
+  int stencil_count;    // grid stencil entries in use (0: not a grid)
+  int pad;
+  Sphere spheres[MAX_SPHERES];
+};
+
+// One neighbour of a grid node: the offset to it and its spring's constants.
+struct StencilEntry {
+  int di, dj, dk;
+  real rest;  // m
+  real k;     // stiffness, N/m
+  real kd;    // damping along the spring, N s/m
+  int pad0, pad1;
+};
+
+DL_FN int grid_node(int i, int j, int k, int nx, int ny) { return (k * ny + j) * nx + i; }
+
+// Node (i, j, k) + (di, dj, dk), or -1 when that lies outside the grid.
+DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj, int dk) {
+  int a = i + di, b = j + dj, c = k + dk;
+  if (a < 0 || a >= p.nx || b < 0 || b >= p.ny || c < 0 || c >= p.nz) return -1;
+  return grid_node(a, b, c, p.nx, p.ny);
+}
+
+// Force on node i from a spring to node j (Hooke + damping along the spring axis):
+//   f_i = -(k (|d| - l) + kd (v_i - v_j).u) u,  d = x_i - x_j,  u = d / |d|.
+// (The paper's eq. (2) drops the minus sign.) Coincident nodes exert no force.
+DL_FN vec3 spring_force(vec3 xi, vec3 xj, vec3 vi, vec3 vj, real k, real kd, real rest) {
+  vec3 d = xi - xj;
+  real len = length(d);
+  if (len == real(0)) return ZERO3;
+  vec3 u = d * (real(1) / len);
+  real s = k * (len - rest);
+  if (kd != real(0)) s += kd * dot(vi - vj, u);  // skipped when undamped: same result, fewer instructions
+  return u * (-s);
+}
+
+// Pinned nodes (zero inverse mass) and the hard-dragged node have no acceleration.
+DL_FN bool node_fixed(CREF(StepParams) p, int i, real inv_mass) {
+  return inv_mass == real(0) || (p.drag_mode == DRAG_HARD && i == p.drag_node);
+}
+
+// Acceleration of node i from the sum of its spring forces: the drag spring's pull, wind,
+// global damping and gravity: a = (f + wind - c v) / m + g.
+DL_FN vec3 node_acceleration(CREF(StepParams) p, int i, real inv_mass, vec3 x, vec3 v, vec3 springs,
+                             vec3 drag_target) {
+  if (node_fixed(p, i, inv_mass)) return ZERO3;
+  vec3 f = springs;
+  if (p.drag_mode == DRAG_SPRING && i == p.drag_node) f += (drag_target - x) * p.drag_stiffness;
+  return (f + p.wind - v * p.damping) * inv_mass + p.gravity;
+}
+
+// Runge-Kutta: a stage state, or a step's result, is s0 + dt sum_j w_j k_j. add_slope adds
+// one term w_j k_j to the sums (dx, dv); rk_state forms the state from them.
+DL_FN void add_slope(INOUT(vec3) dx, INOUT(vec3) dv, real w, vec3 vj, vec3 aj) {
+  dx += vj * w;
+  dv += aj * w;
+}
+DL_FN void rk_state(vec3 x0, vec3 v0, vec3 dx, vec3 dv, real dt, OUT(vec3) x, OUT(vec3) v) {
+  x = x0 + dx * dt;
+  v = v0 + dv * dt;
+}
+
+// The result of a schedule with one force pass: rule RULE_*, weight b_0 of a one-stage
+// Runge-Kutta scheme (explicit Euler), x_prev and has_prev for Verlet. Position Verlet with
+// no previous position starts with the Taylor step x + dt v + dt^2/2 a.
+DL_FN void one_pass_update(int rule, real weight, vec3 x, vec3 v, vec3 a, vec3 x_prev, bool has_prev, real dt,
+                           OUT(vec3) xo, OUT(vec3) vo) {
+  if (rule == RULE_SEMI_IMPLICIT_EULER) {
+    vo = v + a * dt;
+    xo = x + vo * dt;
+  } else if (rule == RULE_VERLET) {
+    vec3 s = has_prev ? (x - x_prev) + a * (dt * dt) : v * dt + a * (real(0.5) * dt * dt);
+    xo = x + s;
+    vo = s * (real(1) / dt);
+  } else {
+    vec3 dx = ZERO3, dv = ZERO3;
+    add_slope(dx, dv, weight, v, a);
+    rk_state(x, v, dx, dv, dt, xo, vo);
+  }
+}
+
+// Ground plane y >= h: clamp the position, remove the velocity into the ground.
+DL_FN void ground_constraint(INOUT(vec3) x, INOUT(vec3) v, real h) {
+  if (x.y < h) {
+    x.y = h;
+    if (v.y < real(0)) v.y = real(0);
+  }
+}
+
+// Sphere collider: a node inside is projected onto the surface (paper eq. 13, corrected)
+// and its inward normal velocity removed. A node at the exact centre goes out along +y.
+DL_FN void sphere_constraint(INOUT(vec3) x, INOUT(vec3) v, vec3 c, real r) {
+  vec3 d = x - c;
+  real len = length(d);
+  if (len >= r) return;
+  vec3 n = len > real(0) ? d * (real(1) / len) : VEC3(real(0), real(1), real(0));
+  x = c + n * r;
+  real vn = dot(v, n);
+  if (vn < real(0)) v -= n * vn;
+}
+
+// The constraints after a step's update: pinned nodes stay where they were, the hard-dragged
+// node sits on its target (drag_target: at the end of the step), other nodes are pushed out of
+// the ground and the spheres.
+DL_FN void constrain_node(CREF(StepParams) p, int i, real inv_mass, vec3 x_old, vec3 drag_target,
+                          INOUT(vec3) x, INOUT(vec3) v) {
+  if (inv_mass == real(0)) {
+    x = x_old;
+    v = ZERO3;
+  } else if (p.drag_mode == DRAG_HARD && i == p.drag_node) {
+    x = drag_target;
+    v = (x - x_old) * (real(1) / p.dt);
+  } else {
+    if (p.has_ground != 0) ground_constraint(x, v, p.ground);
+    for (int q = 0; q < p.sphere_count; ++q) sphere_constraint(x, v, p.spheres[q].center, p.spheres[q].radius);
+  }
+}
+
+// A node's term of the stop rule's reduction: |x - x_old|, or infinity when the new state is
+// not finite, so that the largest term over nodes also flags divergence.
+DL_FN real displacement(vec3 x, vec3 x_old, vec3 v) {
+  real d = length(x - x_old);
+  bool ok = DL_FINITE(d) && DL_FINITE(v.x) && DL_FINITE(v.y) && DL_FINITE(v.z);
+  return ok ? d : DL_INFINITY;
+}
+
+// Energies (physics checks): a free node's kinetic energy and its potential in the constant
+// force fields (gravity, wind); a spring's potential energy.
+DL_FN real kinetic_energy(real inv_mass, vec3 v) {
+  if (inv_mass == real(0)) return real(0);
+  return real(0.5) * (real(1) / inv_mass) * dot(v, v);
+}
+DL_FN real field_energy(CREF(StepParams) p, real inv_mass, vec3 x) {
+  if (inv_mass == real(0)) return real(0);
+  return -dot(p.gravity * (real(1) / inv_mass) + p.wind, x);
+}
+DL_FN real spring_energy(vec3 xi, vec3 xj, real k, real rest) {
+  real stretch = length(xi - xj) - rest;
+  return real(0.5) * k * stretch * stretch;
+}
