@@ -4,9 +4,13 @@
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
 # Environment: BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
-# default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4).
+# default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
+# BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
+# this build's in the same session, for an A/B comparison).
+# The build folder can travel as .dev/build.tgz (scripts/pack-for-device.sh), unpacked here.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+for t in .dev/*.tgz; do [ -f "$t" ] && tar -xzf "$t"; done
 build=${BUILD:-build/default}
 out=${1:-gpu-check}
 max=${MAX_SIZE:-4096}
@@ -27,8 +31,13 @@ if [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
 fi
 
 bench="$build/bench/deformlab-bench"
-"$bench" cuda --sizes 256 1024 2048 4096 --csv "$out/bench-cuda.csv" >"$out/bench-cuda.txt" 2>&1
-"$bench" gl --sizes 256 1024 2048 --csv "$out/bench-gl.csv" >"$out/bench-gl.txt" 2>&1
+bench_pair() {  # name, then the bench arguments: this build's and (BASE_BENCH) the earlier build's rows
+  local name=$1; shift
+  "$bench" "$@" --csv "$out/bench-$name.csv" >"$out/bench-$name.txt" 2>&1
+  if [ -n "${BASE_BENCH:-}" ]; then "$BASE_BENCH" "$@" --csv "$out/bench-$name-base.csv" >"$out/bench-$name-base.txt" 2>&1; fi
+}
+bench_pair cuda cuda --sizes 256 1024 2048 4096
+bench_pair gl gl --sizes 256 1024 2048
 
 app="$build/app/deformlab"
 "$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
