@@ -12,6 +12,7 @@
 #include "ceilings.hpp"
 #include "core/profiler.hpp"
 #include "paper.hpp"
+#include "pipelines.hpp"
 #include "plot.hpp"
 #include "sweep.hpp"
 
@@ -44,6 +45,9 @@ std::string options_label(const json& o) {
   return s;
 }
 
+// A sweep's pipelines are known names (parse_sweep checks them).
+const PipelineTraits& traits_of(const std::string& pipeline) { return pipelines().find(pipeline)->traits; }
+
 struct Column {
   std::string label, pipeline, integrator;
   json options;
@@ -62,7 +66,7 @@ void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& colu
   std::vector<const Column*> cols;
   std::vector<std::pair<std::string, std::vector<std::string>>> bounds;  // what bounds which columns
   for (const auto& c : columns) {
-    const auto b = stage_ceiling(ceil, c.pipeline, "step", 1, *parse_integrator(c.integrator));
+    const auto b = stage_ceiling(ceil, traits_of(c.pipeline), span::step, 1, *parse_integrator(c.integrator));
     const bool measured = std::any_of(sizes.begin(), sizes.end(),
                                       [&](int n) { return ours(c.pipeline, c.integrator, c.options, n) != nullptr; });
     if (!b || !measured) continue;
@@ -86,7 +90,7 @@ void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& colu
         md << " - |";
         continue;
       }
-      const auto b = stage_ceiling(ceil, c->pipeline, "step", (*r)["nodes"].get<std::int64_t>(),
+      const auto b = stage_ceiling(ceil, traits_of(c->pipeline), span::step, (*r)["nodes"].get<std::int64_t>(),
                                    *parse_integrator(c->integrator));
       md << " " << fmt(b->ms) << " (" << percent(100 * b->ms / (*r)["median_ms"].get<double>()) << ") |";
     }
@@ -143,7 +147,8 @@ void write_stages(std::ostringstream& md, const fs::path& dir, const std::string
   md << "\n\n";
   for (const Group& g : groups) {
     const Integrator integ = *parse_integrator(g.integrator);
-    const bool hybrid = g.pipeline.rfind("hybrid", 0) == 0;
+    const PipelineTraits& traits = traits_of(g.pipeline);
+    const bool hybrid = traits.hands_off();
     const double hand_offs = 2.0 * info(integ).force_passes;
     md << "### " << g.label << "\n\n| grid | step ms |";
     for (const auto& st : g.gpu_stages) md << " " << st << " ms |";
@@ -175,7 +180,7 @@ void write_stages(std::ostringstream& md, const fs::path& dir, const std::string
         }
         gpu += *v;
         md << " " << fmt(*v);
-        if (const auto b = stage_ceiling(ceil, g.pipeline, st, nodes, integ)) md << " (" << percent(100 * b->ms / *v) << ")";
+        if (const auto b = stage_ceiling(ceil, traits, st, nodes, integ)) md << " (" << percent(100 * b->ms / *v) << ")";
         md << " |";
         bar.parts.push_back(100 * *v / step);
       }
