@@ -127,10 +127,7 @@ int run_command(const RunArgs& a) {
         throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
 
       // Memory: refuse sizes that cannot fit before allocating them.
-      const auto counts = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
-                                                           : cloth_spring_counts(ms.nx, ms.ny);
-      const std::int64_t nodes = std::int64_t(ms.nx) * ms.ny * ms.nz;
-      const std::int64_t springs = counts[0] + counts[1] + counts[2];
+      const auto [nodes, springs] = model_size(ms);
       const std::int64_t need = model_bytes(nodes, springs) * (a.compare ? 2 : 1);
       const std::int64_t have = available_memory_bytes();
       if (nodes > (std::int64_t(1) << 30) || (have > 0 && need > have)) {
