@@ -45,11 +45,12 @@ std::ofstream open_csv(const std::string& path, const char* header);
 
 // What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.
 struct StepOptions : BenchOptions {
-  int reps = 30;
+  int reps = 0;
 };
-// Adds `name` with StepOptions' flags (defaults from `defaults`); `run` runs it.
-void add_step_bench(CLI::App& app, const char* name, const char* description, const StepOptions& defaults,
-                    void (*run)(const StepOptions&));
+// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given);
+// `run` runs it.
+void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
+                    int reps, void (*run)(const StepOptions&));
 
 void add_cpu_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_CUDA

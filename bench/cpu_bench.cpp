@@ -50,11 +50,8 @@ void run_cpu(const StepOptions& o) {
 }  // namespace
 
 void add_cpu_bench(CLI::App& app) {
-  StepOptions defaults;
-  defaults.sizes = {64, 128, 256, 512};
-  defaults.warmup = 5;
-  defaults.reps = 30;
-  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", defaults, run_cpu);
+  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", {64, 128, 256, 512},
+                 5, 30, run_cpu);
 }
 
 }  // namespace deformlab::bench

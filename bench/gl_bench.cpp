@@ -129,11 +129,8 @@ void run_gl(const StepOptions& o) {
 }  // namespace
 
 void add_gl_bench(CLI::App& app) {
-  StepOptions defaults;
-  defaults.sizes = {256, 512, 1024, 2048};
-  defaults.warmup = 10;
-  defaults.reps = 50;
-  add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling", defaults, run_gl);
+  add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling",
+                 {256, 512, 1024, 2048}, 10, 50, run_gl);
 }
 
 }  // namespace deformlab::bench

@@ -50,9 +50,12 @@ std::ofstream open_csv(const std::string& path, const char* header) {
   return csv;
 }
 
-void add_step_bench(CLI::App& app, const char* name, const char* description, const StepOptions& defaults,
-                    void (*run)(const StepOptions&)) {
-  auto o = std::make_shared<StepOptions>(defaults);
+void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
+                    int reps, void (*run)(const StepOptions&)) {
+  auto o = std::make_shared<StepOptions>();
+  o->sizes = std::move(sizes);
+  o->warmup = warmup;
+  o->reps = reps;
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
   c->add_option("--reps", o->reps, "Timed steps")->check(CLI::PositiveNumber);
