@@ -12,7 +12,7 @@ int list_command() {
   for (const auto& e : pipelines().all()) {
     const std::string why = e.unavailable();
     std::cout << "  " << std::left << std::setw(15) << e.name << (why.empty() ? "available    " : "unavailable  ")
-              << e.summary << (e.deterministic ? "" : " [not bitwise deterministic]") << "\n";
+              << e.summary << (e.traits.deterministic ? "" : " [not bitwise deterministic]") << "\n";
     if (!why.empty()) {
       std::cout << "  " << std::setw(15) << "" << "  why: " << why << "\n";
       continue;

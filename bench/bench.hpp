@@ -1,10 +1,23 @@
-// deformlab-bench: benchmarks, apart from the tests. Each backend adds a subcommand.
+// deformlab-bench: benchmarks, apart from the tests. Each backend adds a subcommand; all
+// run the same scene (BenchScene) and take the same basic flags (BenchOptions).
 #pragma once
 #include <CLI/CLI.hpp>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "core/pipeline.hpp"
+
 namespace deformlab::bench {
+
+// The benches' scene: an n x n cloth of 1 m with its top corners pinned, dt 1 ms (under the
+// stability limit of these grids for the symplectic schemes); pipelines start from rest.
+struct BenchScene {
+  explicit BenchScene(int n);
+  Model model;
+  Params params;
+  PipelineSetup setup(Integrator i) const { return {model, params, i}; }
+};
 
 // Median and spread of a list of timings (ms).
 struct Stats {
@@ -12,16 +25,32 @@ struct Stats {
 };
 Stats stats(std::vector<double> ms);
 
-// What the per-step benches (cpu, gl) take: sizes, warm-up and timed steps, integrator, CSV.
-struct StepOptions {
+// `v` with `prec` decimals; "-" for NaN (not measured).
+std::string fixed(double v, int prec);
+
+// The flags every bench takes: grid sizes, warm-up steps, integrator, CSV file.
+struct BenchOptions {
   std::vector<int> sizes;
-  int warmup = 5, reps = 30;
+  int warmup = 5;
   std::string integrator = "semi-implicit-euler";
   std::string csv;  // also write the rows here when set
+  // `integrator` parsed; throws std::invalid_argument naming it when unknown.
+  Integrator integ() const;
 };
-// Adds `name` with StepOptions' flags (defaults from `defaults`); `run` runs it.
-void add_step_bench(CLI::App& app, const char* name, const char* description, const StepOptions& defaults,
-                    void (*run)(const StepOptions&));
+void add_bench_options(CLI::App& c, BenchOptions& o);
+
+// The CSV file at `path` with its header line written; not open when `path` is empty.
+// Throws std::invalid_argument when it cannot be written.
+std::ofstream open_csv(const std::string& path, const char* header);
+
+// What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.
+struct StepOptions : BenchOptions {
+  int reps = 0;
+};
+// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given);
+// `run` runs it.
+void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
+                    int reps, void (*run)(const StepOptions&));
 
 void add_cpu_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_CUDA

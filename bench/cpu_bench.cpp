@@ -1,13 +1,10 @@
 // `deformlab-bench cpu`: the paper's Table 1 shape, cpu vs omp, ms per step.
 #include <chrono>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <memory>
 
 #include "bench.hpp"
 #include "core/cpu_backend.hpp"
-#include "core/state.hpp"
 
 namespace deformlab::bench {
 
@@ -23,26 +20,19 @@ void time_steps(Pipeline& p, int reps, std::vector<double>& ms) {
 }
 
 void run_cpu(const StepOptions& o) {
-  const auto integ = parse_integrator(o.integrator);
-  if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
+  const Integrator integ = o.integ();
   std::cout << "deformlab-bench cpu: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
             << o.reps << " timed steps; omp uses all hardware threads\n\n"
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
-  std::ofstream csv;
-  if (!o.csv.empty()) {
-    csv.open(o.csv);
-    csv << "grid,nodes,pipeline,median_ms,min_ms,p90_ms\n";
-  }
+  std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
-    Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
-    pin(m, pin_nodes(m, PinSet::top_corners, {}));
-    Params p;
-    p.dt = 0.001f;
+    const BenchScene scene(n);
+    const Model& m = scene.model;
     Stats st[2];
     for (int k = 0; k < 2; ++k) {
-      auto pipe = make_cpu_pipeline({m, p, *integ}, Precision::f32, k == 1);
+      auto pipe = make_cpu_pipeline(scene.setup(integ), Precision::f32, k == 1);
       std::vector<double> ms;
       time_steps(*pipe, o.warmup, ms);
       ms.clear();
@@ -60,11 +50,8 @@ void run_cpu(const StepOptions& o) {
 }  // namespace
 
 void add_cpu_bench(CLI::App& app) {
-  StepOptions defaults;
-  defaults.sizes = {64, 128, 256, 512};
-  defaults.warmup = 5;
-  defaults.reps = 30;
-  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", defaults, run_cpu);
+  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", {64, 128, 256, 512},
+                 5, 30, run_cpu);
 }
 
 }  // namespace deformlab::bench

@@ -5,7 +5,6 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "bench.hpp"
 #include "core/state.hpp"
@@ -15,41 +14,21 @@ namespace deformlab::bench {
 
 namespace {
 
-struct CudaOptions {
-  std::vector<int> sizes{64, 128, 256, 512, 1024, 2048, 4096, 8192};
+// BenchOptions (the main table's sizes and integrator, also the sweeps') and the sweeps'.
+struct CudaOptions : BenchOptions {
   std::vector<std::string> variants{"naive", "tiled", "scatter", "fused"};
-  std::string integrator = "verlet";
   std::vector<std::string> tiles{"8x8", "16x8", "16x16", "32x4", "32x8", "32x16", "64x4", "128x2", "256x1"};
   int tile_size = 2048;
   std::vector<int> graph_sizes{64, 128, 256, 512};
-  int warmup = 10, batches = 15;
+  int batches = 15;
   int copy_mib = 1024;
   double reference_ms = 0.48;
-  std::string csv;
 };
 
 cuda::Variant parse_variant(const std::string& s) {
   for (cuda::Variant v : {cuda::Variant::naive, cuda::Variant::tiled, cuda::Variant::scatter, cuda::Variant::fused})
     if (s == cuda::to_string(v)) return v;
   throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused)");
-}
-
-Integrator parse(const std::string& s) {
-  const auto i = parse_integrator(s);
-  if (!i) throw std::invalid_argument("unknown integrator " + s);
-  return *i;
-}
-
-Model bench_cloth(int n) {
-  Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
-  pin(m, pin_nodes(m, PinSet::top_corners, {}));
-  return m;
-}
-
-Params bench_params() {
-  Params p;
-  p.dt = 0.001f;  // under the stability limit of these grids for the symplectic schemes
-  return p;
 }
 
 // Median ms per step from the rest state: warm-up steps, then `batches` batches timed by
@@ -72,16 +51,14 @@ struct Row {
 
 class Report {
  public:
-  Report(const CudaOptions& o, double copy_gbs) : copy_gbs_(copy_gbs) {
-    if (!o.csv.empty()) {
-      csv_.open(o.csv);
-      if (!csv_) throw std::invalid_argument("cannot write " + o.csv);
-      csv_ << "table,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,effective_GBps,"
-              "fraction_of_copy\n";
-    }
-  }
-  Row measure(const std::string& table, const Model& m, Integrator integ, const cuda::Options& opt, const CudaOptions& o) {
-    auto p = cuda::make_pipeline({m, bench_params(), integ}, opt);
+  Report(const CudaOptions& o, double copy_gbs)
+      : copy_gbs_(copy_gbs),
+        csv_(open_csv(o.csv, "table,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,"
+                             "effective_GBps,fraction_of_copy")) {}
+  Row measure(const std::string& table, const BenchScene& scene, Integrator integ, const cuda::Options& opt,
+              const CudaOptions& o) {
+    const Model& m = scene.model;
+    auto p = cuda::make_pipeline(scene.setup(integ), opt);
     const Stats st = ms_per_step(*p, m, o.warmup, o.batches);
     Row r;
     r.table = table;
@@ -106,15 +83,9 @@ class Report {
   std::ofstream csv_;
 };
 
-std::string fixed(double v, int prec) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(prec) << v;
-  return s.str();
-}
-
 void run_cuda(const CudaOptions& o) {
   if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
-  const Integrator integ = parse(o.integrator);
+  const Integrator integ = o.integ();
   std::vector<cuda::Variant> variants;
   for (const auto& v : o.variants) variants.push_back(parse_variant(v));
 
@@ -138,9 +109,9 @@ void run_cuda(const CudaOptions& o) {
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
             << "B/node" << std::setw(10) << "GB/s" << std::setw(10) << "of copy" << "\n";
   for (int n : o.sizes) {
-    const Model m = bench_cloth(n);
+    const BenchScene scene(n);
     for (cuda::Variant v : variants) {
-      const Row r = rep.measure("steps", m, integ, {v, {}, true}, o);
+      const Row r = rep.measure("steps", scene, integ, {v, {}, true}, o);
       std::cout << std::setw(8) << r.grid << std::setw(10) << r.variant << std::setw(12) << fixed(r.ms, 4)
                 << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(10) << fixed(r.gbs, 0) << std::setw(9)
                 << fixed(100 * r.of_copy, 1) << "%\n";
@@ -152,10 +123,10 @@ void run_cuda(const CudaOptions& o) {
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "graph" << std::setw(12)
             << "launches" << std::setw(10) << "gain" << "\n";
   for (int n : o.graph_sizes) {
-    const Model m = bench_cloth(n);
+    const BenchScene scene(n);
     for (cuda::Variant v : {cuda::Variant::fused, cuda::Variant::naive}) {
-      const Row g = rep.measure("graphs", m, integ, {v, {}, true}, o);
-      const Row l = rep.measure("graphs", m, integ, {v, {}, false}, o);
+      const Row g = rep.measure("graphs", scene, integ, {v, {}, true}, o);
+      const Row l = rep.measure("graphs", scene, integ, {v, {}, false}, o);
       std::cout << std::setw(8) << g.grid << std::setw(10) << g.variant << std::setw(12) << fixed(g.ms, 4)
                 << std::setw(12) << fixed(l.ms, 4) << std::setw(9) << fixed(l.ms / g.ms, 2) << "x\n";
     }
@@ -166,13 +137,13 @@ void run_cuda(const CudaOptions& o) {
               << "): ms/step; tiled stages the block + 2-node halo in shared memory\n"
               << std::setw(8) << "tile" << std::setw(12) << "tiled" << std::setw(12) << "naive" << std::setw(12)
               << "fused" << "\n";
-    const Model m = bench_cloth(o.tile_size);
+    const BenchScene scene(o.tile_size);
     for (const auto& t : o.tiles) {
       const cuda::Tile tile = cuda::parse_tile(t);
       std::cout << std::setw(8) << t;
       for (cuda::Variant v : {cuda::Variant::tiled, cuda::Variant::naive, cuda::Variant::fused})
         std::cout << std::setw(12)
-                  << fixed(rep.measure("tiles", m, integ, {v, tile, true}, o).ms, 4);
+                  << fixed(rep.measure("tiles", scene, integ, {v, tile, true}, o).ms, 4);
       std::cout << "\n";
     }
   }
@@ -183,9 +154,9 @@ void run_cuda(const CudaOptions& o) {
               << "machine type)\n"
               << std::setw(22) << "integrator" << std::setw(12) << "ms/step" << std::setw(10) << "B/node"
               << std::setw(10) << "of copy" << std::setw(14) << "vs reference" << "\n";
-    const Model m = bench_cloth(o.tile_size);
+    const BenchScene scene(o.tile_size);
     for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet}) {
-      const Row r = rep.measure("fused", m, i, {cuda::Variant::fused, {}, true}, o);
+      const Row r = rep.measure("fused", scene, i, {cuda::Variant::fused, {}, true}, o);
       std::cout << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4) << std::setw(10)
                 << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%" << std::setw(13)
                 << fixed(o.reference_ms / r.ms, 2) << "x\n";
@@ -197,20 +168,20 @@ void run_cuda(const CudaOptions& o) {
 
 void add_cuda_bench(CLI::App& app) {
   auto o = std::make_shared<CudaOptions>();
+  o->sizes = {64, 128, 256, 512, 1024, 2048, 4096, 8192};
+  o->integrator = "verlet";
+  o->warmup = 10;
   auto* c = app.add_subcommand("cuda", "CUDA variants: ms/step at 64^2 to 8192^2 against the copy bandwidth, "
                                        "step graphs, tile sweep");
-  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
+  add_bench_options(*c, *o);
   c->add_option("--variants", o->variants, "Variants: naive, tiled, scatter, fused");
-  c->add_option("--integrator", o->integrator, "Integrator of the main table and the sweeps");
   c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
-  c->add_option("--warmup", o->warmup, "Warm-up steps")->check(CLI::PositiveNumber);
   c->add_option("--batches", o->batches, "Timed batches (the median is reported)")->check(CLI::PositiveNumber);
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
       ->check(CLI::PositiveNumber);
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
-  c->add_option("--csv", o->csv, "Also write every measurement to this CSV file");
   c->callback([o] { run_cuda(*o); });
 }
 

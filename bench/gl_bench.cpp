@@ -1,7 +1,6 @@
 // `deformlab-bench gl`: glsl-tf and glsl-compute ms per step on cloth grids, beside a
 // pass-through transform feedback that only copies the two state attributes: the ceiling
 // of the transform-feedback route on this GPU.
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -85,8 +84,7 @@ Stats time_passthrough(int n, const StepOptions& o) {
 }
 
 void run_gl(const StepOptions& o) {
-  const auto integ = parse_integrator(o.integrator);
-  if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
+  const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
   std::cout << "deformlab-bench gl: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
@@ -97,17 +95,11 @@ void run_gl(const StepOptions& o) {
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
             << std::setw(14) << "tf/ceiling" << std::setw(14) << "glsl-compute" << std::setw(16) << "tf Mnodes/s"
             << std::setw(18) << "compute Mnodes/s" << "\n";
-  std::ofstream csv;
-  if (!o.csv.empty()) {
-    csv.open(o.csv);
-    csv << "device,grid,nodes,what,median_ms,min_ms,p90_ms\n";
-  }
+  std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
-    Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
-    pin(m, pin_nodes(m, PinSet::top_corners, {}));
-    Params p;
-    p.dt = 0.001f;
-    const PipelineSetup setup{m, p, *integ};
+    const BenchScene scene(n);
+    const Model& m = scene.model;
+    const PipelineSetup setup = scene.setup(integ);
     Stats ceiling = time_passthrough(m.node_count(), o), tf, compute;
     std::string neighbours;
     {
@@ -137,11 +129,8 @@ void run_gl(const StepOptions& o) {
 }  // namespace
 
 void add_gl_bench(CLI::App& app) {
-  StepOptions defaults;
-  defaults.sizes = {256, 512, 1024, 2048};
-  defaults.warmup = 10;
-  defaults.reps = 50;
-  add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling", defaults, run_gl);
+  add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling",
+                 {256, 512, 1024, 2048}, 10, 50, run_gl);
 }
 
 }  // namespace deformlab::bench

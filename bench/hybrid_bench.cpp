@@ -6,7 +6,6 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
@@ -20,22 +19,13 @@
 namespace deformlab::bench {
 namespace {
 
-struct HybridOptions {
-  std::vector<int> sizes{64, 128, 256, 512, 1024, 2048};
+struct HybridOptions : BenchOptions {
   std::vector<std::string> modes{"map", "external", "external-gpusync", "staged"};
   std::vector<std::string> updates{"tf", "compute"};
-  std::string integrator = "semi-implicit-euler";
-  int warmup = 5, steps = 20;
-  std::string csv;
+  int steps = 20;
   double floor_us = NAN;  // the calibrated floor; measured here when unset and external-gpusync is swept
   bool baselines = true;  // also time cuda-fused and glsl-tf
 };
-
-Model bench_model(int n) {
-  Model m = cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{});
-  pin(m, pin_nodes(m, PinSet::top_corners, {}));
-  return m;
-}
 
 struct Row {
   int n = 0;
@@ -75,23 +65,13 @@ double stage_ms(const Profiler& prof, const char* name) {
   return NAN;
 }
 
-std::string fixed(double v, int prec) {
-  if (std::isnan(v)) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(prec) << v;
-  return s.str();
-}
-
 void run_hybrid(const HybridOptions& o) {
-  const auto integ = parse_integrator(o.integrator);
-  if (!integ) throw std::invalid_argument("unknown integrator " + o.integrator);
+  const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
   const int dev = interop::cuda_device_of_gl();
   const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();
   const double floor_us = !std::isnan(o.floor_us) ? o.floor_us : gpusync ? interop::hand_off_floor_us(2000) : NAN;
-  Params params;
-  params.dt = 0.001f;
-  const int passes = info(*integ).force_passes;
+  const int passes = info(integ).force_passes;
   std::cout << "deformlab-bench hybrid: CUDA device " << dev << ", GL " << ctx.renderer << "\n"
             << "cloth n x n, top corners pinned, " << o.integrator << ", dt 1 ms, from rest; " << o.warmup
             << " warm-up steps, then " << o.steps << " timed steps.\n"
@@ -101,12 +81,8 @@ void run_hybrid(const HybridOptions& o) {
             << "(" << 2 * passes << "); ho-host: host clock inside the hand-off calls per step. floor: GL<->CUDA\n"
             << "semaphore ping-pong with no work, " << fixed(floor_us, 1) << " us per hand-off. bound: wall <= 1.05 x\n"
             << "(update + force + " << 2 * passes << " floors).\n\n";
-  std::ofstream csv;
-  if (!o.csv.empty()) {
-    csv.open(o.csv);
-    if (!csv) throw std::invalid_argument("cannot write " + o.csv);
-    csv << "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us\n";
-  }
+  std::ofstream csv = open_csv(
+      o.csv, "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us");
   std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
             << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
             << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)
@@ -126,8 +102,9 @@ void run_hybrid(const HybridOptions& o) {
   };
 
   for (int n : o.sizes) {
-    const Model m = bench_model(n);
-    const PipelineSetup setup{m, params, *integ};
+    const BenchScene scene(n);
+    const Model& m = scene.model;
+    const PipelineSetup setup = scene.setup(integ);
     if (o.baselines) {
       auto p = cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true});
       p->set_state(rest_state(m));
@@ -182,15 +159,13 @@ void run_hybrid(const HybridOptions& o) {
 
 void add_hybrid_bench(CLI::App& app) {
   auto o = std::make_shared<HybridOptions>();
+  o->sizes = {64, 128, 256, 512, 1024, 2048};
   auto* c = app.add_subcommand("hybrid", "Hybrid pipelines per interop mode, split by stage, against glsl-tf and "
                                          "cuda-fused");
-  c->add_option("--sizes", o->sizes, "Grid sizes (n for n x n)");
+  add_bench_options(*c, *o);
   c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
   c->add_option("--updates", o->updates, "Update passes: tf, compute");
-  c->add_option("--integrator", o->integrator, "Integrator");
-  c->add_option("--warmup", o->warmup, "Warm-up steps")->check(CLI::PositiveNumber);
   c->add_option("--steps", o->steps, "Timed steps")->check(CLI::PositiveNumber);
-  c->add_option("--csv", o->csv, "Also write every row to this CSV file");
   c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
   c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
   c->callback([o] { run_hybrid(*o); });

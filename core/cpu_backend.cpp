@@ -271,14 +271,15 @@ std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p,
 void add_cpu_pipelines(PipelineRegistry& r) {
   auto always = [] { return std::string(); };
   auto every = [](Integrator) { return std::string(); };
-  r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", true, always, every,
+  const PipelineTraits as_cpu{}, in_double{.cpu_match = CpuMatch::rounding};
+  r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", as_cpu, always, every,
          [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }});
   r.add({"omp", "OpenMP float, up to " + std::to_string(omp_get_max_threads()) + " threads of at least " +
                     std::to_string(CpuPipeline<float>::kNodesPerThread) +
                     " nodes each (the paper's optimised CPU); bitwise equal to cpu",
-         true, always, every,
+         as_cpu, always, every,
          [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }});
-  r.add({"reference", "OpenMP double: the reference for tests and --compare", true, always, every,
+  r.add({"reference", "OpenMP double: the reference for tests and --compare", in_double, always, every,
          [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }});
 }
 

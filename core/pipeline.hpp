@@ -43,10 +43,28 @@ struct PipelineSetup {
   PipelineOptions options = {};
 };
 
+// What runs a pipeline's force or update passes. Reports bound each pass by the calibrated
+// ceiling of what runs it (experiments/ceilings.hpp).
+enum class Engine { cpu, cuda, gl_compute, gl_transform_feedback };
+
+// How a pipeline's results compare with the `cpu` pipeline's from the same state.
+enum class CpuMatch { bitwise, rounding };
+
+// What a pipeline is, as plain data for tests, sweeps and reports. A name carries the same
+// traits whether or not this build has its backend (experiments/pipelines.cpp).
+struct PipelineTraits {
+  Engine force = Engine::cpu, update = Engine::cpu;
+  bool deterministic = true;  // bitwise equal run to run
+  CpuMatch cpu_match = CpuMatch::bitwise;
+  // Its passes run on two APIs, which hand the state over twice per force evaluation.
+  bool hands_off() const { return force != update; }
+  bool operator==(const PipelineTraits&) const = default;
+};
+
 struct PipelineEntry {
   std::string name;
   std::string summary;
-  bool deterministic = true;  // bitwise equal run to run
+  PipelineTraits traits;
   // Empty when usable on this build and machine, else the reason it is not.
   std::function<std::string()> unavailable;
   // Empty when the pipeline runs this integrator, else the reason it does not.

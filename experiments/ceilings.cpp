@@ -24,12 +24,20 @@ std::optional<Bound> bytes_at(double bytes, double gb_s, const std::string& what
   return Bound{bytes / (gb_s * 1e9) * 1e3, what};
 }
 
-std::optional<Bound> vertices_at(double vertices, double per_s) {
-  if (per_s <= 0) return std::nullopt;
-  return Bound{vertices / per_s * 1e3, "one transform feedback vertex per node and evaluation"};
+// One pass over `n` nodes on `e`, moving `bytes` per node where it moves bytes; `what` says
+// what it moves.
+std::optional<Bound> pass_at(const Ceilings& c, Engine e, double bytes, double n, const std::string& what) {
+  switch (e) {
+    case Engine::cuda: return bytes_at(bytes * n, c.copy_gb_s, what + " at the CUDA copy bandwidth");
+    case Engine::gl_compute:
+      return bytes_at(bytes * n, c.compute_copy_gb_s, what + " at the compute-shader copy bandwidth");
+    case Engine::gl_transform_feedback:
+      if (c.tf_vertices_s <= 0) return std::nullopt;
+      return Bound{n / c.tf_vertices_s * 1e3, "one transform feedback vertex per node and evaluation"};
+    case Engine::cpu: break;
+  }
+  return std::nullopt;
 }
-
-bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
 }  // namespace
 
@@ -56,38 +64,24 @@ json read_calibration(const std::filesystem::path& file) {
   return j;
 }
 
-std::optional<Bound> stage_ceiling(const Ceilings& c, const std::string& pipeline, const std::string& stage,
+std::optional<Bound> stage_ceiling(const Ceilings& c, const PipelineTraits& t, const std::string& stage,
                                    std::int64_t nodes, Integrator integrator) {
   const double evals = info(integrator).force_passes, n = double(nodes) * evals;
-  const bool hybrid = starts_with(pipeline, "hybrid");
-  const bool tf_update = pipeline == "glsl-tf" || pipeline == "hybrid";
-  const std::string copy = "at the CUDA copy bandwidth";
-  if (stage == span::force && (hybrid || starts_with(pipeline, "cuda-")))
-    return bytes_at(48 * n, c.copy_gb_s, "x, v read, a written once per evaluation (48 B/node) " + copy);
-  if (stage == span::update && starts_with(pipeline, "cuda-"))
-    return bytes_at(80 * n, c.copy_gb_s, "x, v, a read, x, v written once per evaluation (80 B/node) " + copy);
-  if (stage == span::update && hybrid)
-    return tf_update ? vertices_at(n, c.tf_vertices_s)
-                     : bytes_at(80 * n, c.compute_copy_gb_s,
-                                "x, v, a read, x, v written once per evaluation (80 B/node) at the compute-shader "
-                                "copy bandwidth");
-  if (stage == span::hand_off && hybrid && c.floor_us > 0)
-    return Bound{2 * evals * c.floor_us * 1e-3, "two hand-offs per evaluation at the floor"};
-  const bool whole = stage == "step" || stage == span::force_update;
-  if (whole && starts_with(pipeline, "cuda-"))
-    return bytes_at(64 * n, c.copy_gb_s, "x, v read and written once per evaluation (64 B/node) " + copy);
-  if (whole && pipeline == "glsl-compute")
-    return bytes_at(64 * n, c.compute_copy_gb_s,
-                    "x, v read and written once per evaluation (64 B/node) at the compute-shader copy bandwidth");
-  if (whole && pipeline == "glsl-tf") return vertices_at(n, c.tf_vertices_s);
-  if (stage == "step" && hybrid) {
-    const auto f = stage_ceiling(c, pipeline, span::force, nodes, integrator);
-    const auto u = stage_ceiling(c, pipeline, span::update, nodes, integrator);
-    const auto h = stage_ceiling(c, pipeline, span::hand_off, nodes, integrator);
-    if (!f || !u || !h) return std::nullopt;
-    return Bound{f->ms + u->ms + h->ms, "its force and update ceilings plus two floors per evaluation"};
+  if (stage == span::force) return pass_at(c, t.force, 48, n, "x, v read, a written once per evaluation (48 B/node)");
+  if (stage == span::update)
+    return pass_at(c, t.update, 80, n, "x, v, a read, x, v written once per evaluation (80 B/node)");
+  if (!t.hands_off()) {
+    if (stage != span::step && stage != span::force_update) return std::nullopt;
+    return pass_at(c, t.force, 64, n, "x, v read and written once per evaluation (64 B/node)");
   }
-  return std::nullopt;
+  if (stage == span::hand_off && c.floor_us > 0)
+    return Bound{2 * evals * c.floor_us * 1e-3, "two hand-offs per evaluation at the floor"};
+  if (stage != span::step) return std::nullopt;
+  const auto f = stage_ceiling(c, t, span::force, nodes, integrator);
+  const auto u = stage_ceiling(c, t, span::update, nodes, integrator);
+  const auto h = stage_ceiling(c, t, span::hand_off, nodes, integrator);
+  if (!f || !u || !h) return std::nullopt;
+  return Bound{f->ms + u->ms + h->ms, "its force and update ceilings plus two floors per evaluation"};
 }
 
 }  // namespace deformlab

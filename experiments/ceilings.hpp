@@ -2,14 +2,16 @@
 // of a GPU pipeline could take on it, so that reports show measured times as fractions of
 // their own ceilings and hand-offs against the floor.
 //
-// Per force evaluation and node, the least a stage must do:
+// Per force evaluation and node, the least a pass must do on what runs it (the pipeline's
+// traits, core/pipeline.hpp):
 //   CUDA and compute-shader passes move their state once at the calibrated copy bandwidth
 //   (CUDA: device-to-device copy; GL compute: compute-shader copy): a force pass reads x, v
 //   and writes a (48 B), an update reads x, v, a and writes x, v (80 B), a fused
 //   force+update pass reads and writes x, v (64 B). Neighbour reads are left out (caches
 //   serve them), so these bounds are optimistic.
 //   Transform feedback passes emit one vertex per node at the pass-through vertex rate.
-//   A hybrid step hands off twice per force evaluation, each at least the floor.
+//   A pipeline whose passes run on two APIs hands off twice per force evaluation, each at
+//   least the floor.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -18,6 +20,7 @@
 #include <string>
 
 #include "core/integrator.hpp"
+#include "core/pipeline.hpp"
 
 namespace deformlab {
 
@@ -35,14 +38,14 @@ Ceilings ceilings_of(const nlohmann::json& calibration);
 // when it is not JSON or has none of the ceilings above.
 nlohmann::json read_calibration(const std::filesystem::path& file);
 
-// The least time in ms per step of `stage` (a span name, or "step" for the whole step) of
-// `pipeline` on `nodes` nodes, and what bounds it; nullopt where none applies
-// (CPU pipelines, stages without a ceiling, an uncalibrated ceiling).
+// The least time in ms per step of `stage` (a span name; span::step for the whole step) of
+// a pipeline with `traits` on `nodes` nodes, and what bounds it; nullopt where none
+// applies (CPU pipelines, stages without a ceiling, an uncalibrated ceiling).
 struct Bound {
   double ms;
   std::string what;
 };
-std::optional<Bound> stage_ceiling(const Ceilings& c, const std::string& pipeline, const std::string& stage,
+std::optional<Bound> stage_ceiling(const Ceilings& c, const PipelineTraits& traits, const std::string& stage,
                                    std::int64_t nodes, Integrator integrator);
 
 }  // namespace deformlab

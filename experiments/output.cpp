@@ -131,4 +131,10 @@ std::int64_t available_memory_bytes() {
   return -1;
 }
 
+ModelSize model_size(const ModelSpec& ms) {
+  const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
+                                                  : cloth_spring_counts(ms.nx, ms.ny);
+  return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2]};
+}
+
 }  // namespace deformlab

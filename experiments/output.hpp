@@ -7,6 +7,7 @@
 
 #include "core/model.hpp"
 #include "core/run.hpp"
+#include "core/scene.hpp"
 #include "core/state.hpp"
 
 namespace deformlab {
@@ -45,5 +46,11 @@ nlohmann::json build_info();
 
 // Bytes of memory available to this process now (MemAvailable), or -1 if unknown.
 std::int64_t available_memory_bytes();
+
+// The nodes and springs a model spec builds, counted without building it.
+struct ModelSize {
+  std::int64_t nodes = 0, springs = 0;
+};
+ModelSize model_size(const ModelSpec& ms);
 
 }  // namespace deformlab

@@ -16,25 +16,37 @@
 namespace deformlab {
 namespace {
 
+// Each pipeline as every build knows it: its traits and options are checked against the
+// registered entry where the build has it, and carried by the placeholder where not.
 struct Known {
   const char* name;
   const char* summary;
   const char* needs;  // why it may be missing from a build
+  PipelineTraits traits;
+  std::vector<std::string> options = {};
 };
+
+constexpr PipelineTraits on(Engine e, bool deterministic = true, CpuMatch m = CpuMatch::rounding) {
+  return {e, e, deterministic, m};
+}
+constexpr PipelineTraits hybrid(Engine update) { return {Engine::cuda, update, true, CpuMatch::rounding}; }
 
 // In order of expected speed on a GPU machine; the CPU pipelines close the list.
 const Known kKnown[] = {
-    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA"},
-    {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA"},
-    {"cuda-naive", "CUDA, one thread per node gathering from global memory", "CUDA"},
-    {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA"},
-    {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL"},
-    {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL"},
-    {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL"},
-    {"hybrid-compute", "CUDA forces into GL buffers, compute-shader update", "CUDA and OpenGL"},
-    {"omp", "", ""},
-    {"cpu", "", ""},
-    {"reference", "", ""},
+    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
+    {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
+    {"cuda-naive", "CUDA, one thread per node gathering from global memory", "CUDA",
+     on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
+    {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false)},
+    {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute)},
+    {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL", on(Engine::gl_transform_feedback)},
+    {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL",
+     hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile"}},
+    {"hybrid-compute", "CUDA forces into GL buffers, compute-shader update", "CUDA and OpenGL",
+     hybrid(Engine::gl_compute), {"interop", "force", "tile"}},
+    {"omp", "", "", {}},
+    {"cpu", "", "", {}},
+    {"reference", "", "", {.cpu_match = CpuMatch::rounding}},
 };
 
 PipelineRegistry build() {
@@ -52,12 +64,15 @@ PipelineRegistry build() {
   PipelineRegistry r;
   for (const auto& k : kKnown) {
     if (const PipelineEntry* e = built.find(k.name)) {
+      if (!(e->traits == k.traits) || e->options != k.options)
+        throw std::logic_error(std::string("pipeline ") + k.name + " registers other traits or options than kKnown's");
       r.add(*e);
       continue;
     }
     const std::string why = std::string("not in this build (needs ") + k.needs + " support at configure time)";
-    r.add({k.name, k.summary, true, [why] { return why; }, [why](Integrator) { return why; },
-           [why](const PipelineSetup&) -> std::unique_ptr<Pipeline> { throw std::invalid_argument(why); }});
+    r.add({k.name, k.summary, k.traits, [why] { return why; }, [why](Integrator) { return why; },
+           [why](const PipelineSetup&) -> std::unique_ptr<Pipeline> { throw std::invalid_argument(why); },
+           k.options});
   }
   for (const auto& e : built.all())
     if (!r.find(e.name)) r.add(e);

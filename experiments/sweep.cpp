@@ -6,7 +6,6 @@
 #include <cmath>
 #include <chrono>
 #include <fstream>
-#include <sstream>
 
 #include "core/run.hpp"
 #include "core/scene.hpp"
@@ -128,125 +127,6 @@ std::vector<Cell> cells(const Sweep& s) {
         for (const auto& o : sets) out.push_back({n, pipe, integ, o});
       }
   return out;
-}
-
-json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache) {
-  using clock = std::chrono::steady_clock;
-  json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
-            {"options", c.options}};
-  auto na = [&](const std::string& why) {
-    r["status"] = "n/a";
-    r["reason"] = why;
-    return r;
-  };
-  const PipelineEntry& e = *pipelines().find(c.pipeline);
-  const Integrator integ = *parse_integrator(c.integrator);
-  if (auto why = e.unavailable(); !why.empty()) return na(why);
-  if (auto why = e.unsupported(integ); !why.empty()) return na(why);
-
-  Scene scene = x.scene;
-  ModelSpec& ms = scene.model;
-  ms.nx = ms.ny = c.size;
-  ms.nz = ms.topology == Topology::lattice ? c.size : 1;
-  const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
-                                                  : cloth_spring_counts(ms.nx, ms.ny);
-  const std::int64_t nodes = std::int64_t(ms.nx) * ms.ny * ms.nz, springs = k[0] + k[1] + k[2];
-  r["nodes"] = nodes;
-  r["springs"] = springs;
-  const std::int64_t need = model_bytes(nodes, springs), have = available_memory_bytes();
-  if (nodes > (std::int64_t(1) << 30) || (have > 0 && need > have))
-    return na("does not fit: needs about " + std::to_string(need >> 20) + " MiB of host memory, " +
-              std::to_string(have >> 20) + " MiB available");
-  try {
-    if (cache.size != c.size || !cache.model) {
-      cache.model.reset();  // free the old one before building the next
-      cache.model = std::make_unique<Model>(build_model(scene));
-      cache.size = c.size;
-    }
-    const Model& m = *cache.model;
-    const Params p = resolve_params(scene, m);
-    auto pipe = e.make({m, p, integ, c.options});
-    pipe->set_state(rest_state(m));
-    // "frame": every step is followed by a draw of the state at 1024 x 1024 (the paper's
-    // frame); pipelines outside GL hand their state over through a read-back.
-#if DEFORMLAB_HAVE_GL
-    std::unique_ptr<gl::Renderer> renderer;
-    if (s.time == "frame") {
-      if (auto why = gl::unavailable_reason(); !why.empty()) return na("frame timing needs OpenGL: " + why);
-      renderer = std::make_unique<gl::Renderer>(m);
-    }
-    auto step = [&] {
-      pipe->step();
-      if (renderer) renderer->draw(*pipe);
-    };
-    auto finish = [&] {
-      pipe->max_displacement();
-      if (renderer) renderer->take_draw_ms();  // waits for the draws
-    };
-#else
-    if (s.time == "frame") return na("frame timing needs a build with OpenGL");
-    auto step = [&] { pipe->step(); };
-    auto finish = [&] { pipe->max_displacement(); };
-#endif
-    // One step first: it bounds the cell's time before committing to it.
-    const auto t0 = clock::now();
-    step();
-    finish();
-    const double first_s = std::chrono::duration<double>(clock::now() - t0).count();
-    const double expect_s = first_s * (s.warmup + double(s.steps) * s.repetitions);
-    if (expect_s > s.cell_limit_s) {
-      std::ostringstream os;
-      os << "cut: the first step took " << first_s << " s, the cell would need about " << expect_s
-         << " s, over its limit of " << s.cell_limit_s << " s";
-      return na(os.str());
-    }
-    for (int w = 1; w < s.warmup; ++w) step();
-    finish();
-    std::vector<double> ms_per_step;
-    for (int rep = 0; rep < s.repetitions; ++rep) {
-      const auto b0 = clock::now();
-      for (int st = 0; st < s.steps; ++st) step();
-      finish();  // waits for the device's last step (and draw)
-      ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
-    }
-    const double d = pipe->max_displacement();
-    // One more batch with a profiler attached, for each stage's time per step; it is kept
-    // out of the timed batches (a profiled CUDA pipeline runs pass by pass, not as a graph).
-    Profiler prof;
-    pipe->set_profiler(&prof);
-    for (int st = 1; st <= s.steps; ++st) {
-      prof.set_step(st);
-      step();
-    }
-    finish();
-    pipe->set_profiler(nullptr);
-    json stages = json::array();
-    for (const auto& g : prof.summary())
-      stages.push_back({{"name", g.name},
-                        {"median_ms", g.median_ms},
-                        {"clock", g.clock},
-                        {"per_step", double(g.spans) / g.steps}});
-    if (!stages.empty()) r["stages"] = stages;
-    r["status"] = "ok";
-    r["median_ms"] = median(ms_per_step);
-    r["min_ms"] = *std::min_element(ms_per_step.begin(), ms_per_step.end());
-    r["samples_ms"] = ms_per_step;
-    r["stable"] = d == d;
-    r["pipeline_timing"] = pipe->timing_method();
-    r["time"] = s.time;
-    r["method"] = "host steady_clock around " + std::to_string(s.steps) +
-                  (s.time == "frame" ? " frames (a step and a 1024 x 1024 draw each)" : " steps") +
-                  " closed by the pipeline's max-displacement reduction (which waits for the device), "
-                  "ms per " + (s.time == "frame" ? "frame" : "step") + ", median of " +
-                  std::to_string(s.repetitions) + " batches after " + std::to_string(s.warmup) + " warm-up steps";
-    return r;
-  } catch (const std::invalid_argument& ex) {
-    return na(ex.what());
-  } catch (const std::bad_alloc&) {
-    return na("does not fit: out of host memory");
-  } catch (const std::exception& ex) {  // a pipeline failed (a driver error, a divergence)
-    return na(std::string("failed: ") + ex.what());
-  }
 }
 
 json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {

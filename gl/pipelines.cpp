@@ -14,10 +14,12 @@ void add_gl_pipelines(PipelineRegistry& r) {
                  : std::string();
     };
   };
-  r.add({"glsl-compute", "GLSL compute shaders over storage buffers", true, unavailable, unsupported("glsl-compute"),
-         gl::make_compute_pipeline});
-  r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", true, unavailable, unsupported("glsl-tf"),
-         gl::make_tf_pipeline});
+  // Deterministic, and equal to the CPU within rounding (the GPU's arithmetic differs).
+  auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
+  r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,
+         unsupported("glsl-compute"), gl::make_compute_pipeline});
+  r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", on(Engine::gl_transform_feedback),
+         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline});
 }
 
 }  // namespace deformlab

@@ -11,15 +11,17 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   // mode's own needs are checked when the pipeline is made (they depend on the option).
   auto unavailable = [] { return interop::unavailable(interop::Mode::map); };
   auto unsupported = [](Integrator i) { return interop::hybrid_unsupported(i); };
+  // CUDA forces, a GL update: equal to the CPU within rounding.
+  auto updating_on = [](Engine e) { return PipelineTraits{Engine::cuda, e, true, CpuMatch::rounding}; };
   const std::vector<std::string> options = {"interop", "force", "tile"};
-  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile)", true, unavailable,
-         unsupported,
+  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile)",
+         updating_on(Engine::gl_transform_feedback), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
          },
          options});
-  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile)", true,
-         unavailable, unsupported,
+  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile)",
+         updating_on(Engine::gl_compute), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
          },

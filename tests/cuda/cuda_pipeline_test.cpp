@@ -239,7 +239,7 @@ TEST(CudaPipeline, RegistryNamesTheFourVariants) {
   for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-scatter", "cuda-fused"}) {
     const PipelineEntry* e = r.find(n);
     ASSERT_NE(e, nullptr) << n;
-    EXPECT_EQ(e->deterministic, std::string(n) != "cuda-scatter") << n;
+    EXPECT_EQ(e->traits.deterministic, std::string(n) != "cuda-scatter") << n;
     EXPECT_FALSE(e->unsupported(Integrator::backward_euler).empty());
     EXPECT_EQ(e->unavailable(), cuda::unavailable());
   }

@@ -1,0 +1,137 @@
+#include "run_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "experiments/output.hpp"
+#include "experiments/pipelines.hpp"
+#if DEFORMLAB_GL_RENDER
+#include "gl/context.hpp"
+#endif
+
+namespace deformlab::app {
+namespace {
+
+struct BadInput : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+// "128x96" -> {128, 96}; `dims` numbers, each a positive integer.
+std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
+  const std::string pat = dims == 2 ? "WxH" : "WxHxD";
+  std::vector<int> out;
+  std::stringstream ss(s);
+  for (std::string part; std::getline(ss, part, 'x');) {
+    if (part.empty() || !std::all_of(part.begin(), part.end(), ::isdigit))
+      throw BadInput(std::string(flag) + " '" + s + "': expected " + pat + " with positive integers");
+    const long long v = std::stoll(part.size() > 12 ? std::string("9999999999999") : part);
+    if (v <= 0 || v > 1'000'000'000)
+      throw BadInput(std::string(flag) + " '" + s + "': each size must be between 1 and 10^9");
+    out.push_back(int(v));
+  }
+  if (int(out.size()) != dims || s.back() == 'x')
+    throw BadInput(std::string(flag) + " '" + s + "': expected " + pat);
+  return out;
+}
+
+// The GL flags, then the experiment (or the default one) with --scene, --pipeline and
+// --integrator applied.
+Experiment read_experiment(const RunArgs& a) {
+#if DEFORMLAB_GL_RENDER
+  if (a.gl_device) gl::configure({.device = *a.gl_device});
+  if (a.frames && *a.frames < 1) throw BadInput("--frames must be at least 1");
+#else
+  if (a.frames || a.gl_device) throw BadInput("--frames and --gl-device need a build with OpenGL");
+#endif
+  Experiment x = a.experiment ? load_experiment(*a.experiment) : default_experiment();
+  if (a.scene) x.scene = load_scene(*a.scene);
+  if (a.pipeline) x.pipeline = *a.pipeline;
+  if (a.integrator) x.integrator = *a.integrator;
+  return x;
+}
+
+// The experiment's pipeline ("best": the best here for `integ`), available and running `integ`.
+const PipelineEntry* pick_pipeline(const Experiment& x, Integrator integ) {
+  const PipelineEntry* entry = x.pipeline == "best" ? &best_pipeline(integ) : pipelines().find(x.pipeline);
+  if (!entry) throw BadInput("unknown pipeline '" + x.pipeline + "' (valid: best, " + pipelines().names() + ")");
+  if (const auto why = entry->unavailable(); !why.empty())
+    throw BadInput("pipeline '" + entry->name + "' is not available: " + why);
+  if (const auto why = entry->unsupported(integ); !why.empty())
+    throw BadInput("integrator '" + x.integrator + "' is not available on " + entry->name + ": " + why);
+  return entry;
+}
+
+// --option NAME=VALUE flags, each an option the pipeline reads.
+PipelineOptions parse_options(const std::vector<std::string>& flags, const PipelineEntry& entry) {
+  PipelineOptions options;
+  for (const auto& o : flags) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0) throw BadInput("--option '" + o + "': expected NAME=VALUE");
+    const std::string name = o.substr(0, eq);
+    if (std::find(entry.options.begin(), entry.options.end(), name) == entry.options.end())
+      throw BadInput("--option '" + name + "' is not an option of " + entry.name +
+                     (entry.options.empty() ? " (it has none)" : ""));
+    options[name] = o.substr(eq + 1);
+  }
+  return options;
+}
+
+void apply_model_flags(const RunArgs& a, ModelSpec& ms) {
+  if (a.grid) {
+    const auto d = parse_size(*a.grid, 2, "--grid");
+    ms.topology = Topology::cloth_grid;
+    ms.nx = d[0]; ms.ny = d[1]; ms.nz = 1;
+  }
+  if (a.lattice) {
+    const auto d = parse_size(*a.lattice, 3, "--lattice");
+    ms.topology = Topology::lattice;
+    ms.nx = d[0]; ms.ny = d[1]; ms.nz = d[2];
+  }
+}
+
+void apply_param_flags(const RunArgs& a, Params& p) {
+  if (a.dt) p.dt = float(*a.dt);
+  if (a.dt && !(std::isfinite(*a.dt) && *a.dt > 0)) throw BadInput("--dt must be a positive finite number of seconds");
+  if (a.threshold) p.threshold = float(*a.threshold);
+  if (a.check_every) p.check_every = *a.check_every;
+  if (a.steps) p.max_steps = *a.steps;
+  if (a.steps && *a.steps < 1) throw BadInput("--steps must be at least 1");
+}
+
+// Refuses sizes that cannot fit (`copies` models: 2 with --compare) before allocating them.
+void check_fits(const ModelSpec& ms, int copies) {
+  const auto [nodes, springs] = model_size(ms);
+  const std::int64_t need = model_bytes(nodes, springs) * copies;
+  const std::int64_t have = available_memory_bytes();
+  if (nodes <= (std::int64_t(1) << 30) && (have <= 0 || need <= have)) return;
+  std::ostringstream os;
+  os << "a model of " << nodes << " nodes and " << springs << " springs needs about "
+     << double(need) / double(1 << 30) << " GiB of memory";
+  if (have > 0) os << ", " << double(have) / double(1 << 30) << " GiB are available";
+  if (nodes > (std::int64_t(1) << 30)) os << " (and exceeds the limit of 2^30 nodes)";
+  throw BadInput(os.str());
+}
+
+}  // namespace
+
+RunInput read_run_input(const RunArgs& a) {
+  RunInput in;
+  in.x = read_experiment(a);
+  const auto i = parse_integrator(in.x.integrator);
+  if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");
+  in.integ = *i;
+  in.entry = pick_pipeline(in.x, in.integ);
+  in.options = parse_options(a.options, *in.entry);
+  apply_model_flags(a, in.x.scene.model);
+  apply_param_flags(a, in.x.scene.params);
+  in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
+  if (a.compare && *a.compare != "cpu")
+    throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
+  check_fits(in.x.scene.model, a.compare ? 2 : 1);
+  in.model = build_model(in.x.scene);
+  in.params = resolve_params(in.x.scene, in.model);
+  return in;
+}
+
+}  // namespace deformlab::app

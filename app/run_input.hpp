@@ -1,0 +1,26 @@
+// `deformlab run`'s input: everything read and checked before anything is written.
+#pragma once
+#include "commands.hpp"
+#include "core/model.hpp"
+#include "core/params.hpp"
+#include "core/pipeline.hpp"
+#include "experiments/experiment.hpp"
+
+namespace deformlab::app {
+
+struct RunInput {
+  Experiment x;
+  const PipelineEntry* entry = nullptr;
+  Integrator integ{};
+  PipelineOptions options;
+  bool until_converged = false;
+  Model model;
+  Params params;
+};
+
+// Reads the experiment or scene, applies the flags and builds the model; bad input
+// (unknown names, bad sizes or numbers, a model too large for memory) throws
+// std::invalid_argument with one line saying what is wrong.
+RunInput read_run_input(const RunArgs& a);
+
+}  // namespace deformlab::app

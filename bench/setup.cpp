@@ -1,0 +1,65 @@
+// The benches' shared scene, flags, statistics and CSV files (bench.hpp).
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include "bench.hpp"
+#include "core/profiler.hpp"
+
+namespace deformlab::bench {
+
+BenchScene::BenchScene(int n) : model(cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{})) {
+  pin(model, pin_nodes(model, PinSet::top_corners, {}));
+  params.dt = 0.001f;
+}
+
+Stats stats(std::vector<double> ms) {
+  if (ms.empty()) return {};
+  std::sort(ms.begin(), ms.end());
+  return {median(ms), ms.front(), ms[std::min(ms.size() - 1, ms.size() * 9 / 10)]};
+}
+
+std::string fixed(double v, int prec) {
+  if (std::isnan(v)) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(prec) << v;
+  return s.str();
+}
+
+Integrator BenchOptions::integ() const {
+  const auto i = parse_integrator(integrator);
+  if (!i) throw std::invalid_argument("unknown integrator " + integrator);
+  return *i;
+}
+
+void add_bench_options(CLI::App& c, BenchOptions& o) {
+  c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
+  c.add_option("--warmup", o.warmup, "Warm-up steps")->check(CLI::PositiveNumber);
+  c.add_option("--integrator", o.integrator, "Integrator");
+  c.add_option("--csv", o.csv, "Also write the results to this CSV file");
+}
+
+std::ofstream open_csv(const std::string& path, const char* header) {
+  std::ofstream csv;
+  if (path.empty()) return csv;
+  csv.open(path);
+  if (!csv) throw std::invalid_argument("cannot write " + path);
+  csv << header << "\n";
+  return csv;
+}
+
+void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
+                    int reps, void (*run)(const StepOptions&)) {
+  auto o = std::make_shared<StepOptions>();
+  o->sizes = std::move(sizes);
+  o->warmup = warmup;
+  o->reps = reps;
+  auto* c = app.add_subcommand(name, description);
+  add_bench_options(*c, *o);
+  c->add_option("--reps", o->reps, "Timed steps")->check(CLI::PositiveNumber);
+  c->callback([o, run] { run(*o); });
+}
+
+}  // namespace deformlab::bench

@@ -1,0 +1,191 @@
+// One cell of a sweep (sweep.hpp's run_cell): sized, bounded in time, timed, profiled.
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "core/scene.hpp"
+#include "core/state.hpp"
+#include "output.hpp"
+#include "pipelines.hpp"
+#include "sweep.hpp"
+#if DEFORMLAB_HAVE_GL
+#include "gl/context.hpp"
+#include "gl/render.hpp"
+#endif
+
+namespace deformlab {
+
+using nlohmann::json;
+
+namespace {
+
+using clock = std::chrono::steady_clock;
+
+json not_applicable(json r, const std::string& why) {
+  r["status"] = "n/a";
+  r["reason"] = why;
+  return r;
+}
+
+// Sizes the scene's model to the cell and records its nodes and springs in `r`; returns why
+// it does not fit here, else "".
+std::string size_model(Scene& scene, const Cell& c, json& r) {
+  ModelSpec& ms = scene.model;
+  ms.nx = ms.ny = c.size;
+  ms.nz = ms.topology == Topology::lattice ? c.size : 1;
+  const ModelSize size = model_size(ms);
+  r["nodes"] = size.nodes;
+  r["springs"] = size.springs;
+  const std::int64_t need = model_bytes(size.nodes, size.springs), have = available_memory_bytes();
+  if (size.nodes <= (std::int64_t(1) << 30) && (have <= 0 || need <= have)) return {};
+  return "does not fit: needs about " + std::to_string(need >> 20) + " MiB of host memory, " +
+         std::to_string(have >> 20) + " MiB available";
+}
+
+const Model& cached_model(ModelCache& cache, const Scene& scene, int size) {
+  if (cache.size != size || !cache.model) {
+    cache.model.reset();  // free the old one before building the next
+    cache.model = std::make_unique<Model>(build_model(scene));
+    cache.size = size;
+  }
+  return *cache.model;
+}
+
+// A cell's steps. With "frame" timing every step is followed by a draw of the state at
+// 1024 x 1024 (the paper's frame); pipelines outside GL hand their state over through a
+// read-back. Frame timing without OpenGL throws std::invalid_argument (the cell is n/a).
+class CellSteps {
+ public:
+  CellSteps(Pipeline& pipe, const Model& m, const std::string& time) : pipe_(pipe) {
+#if DEFORMLAB_HAVE_GL
+    if (time != "frame") return;
+    if (auto why = gl::unavailable_reason(); !why.empty())
+      throw std::invalid_argument("frame timing needs OpenGL: " + why);
+    renderer_ = std::make_unique<gl::Renderer>(m);
+#else
+    (void)m;
+    if (time == "frame") throw std::invalid_argument("frame timing needs a build with OpenGL");
+#endif
+  }
+  void step() {
+    pipe_.step();
+#if DEFORMLAB_HAVE_GL
+    if (renderer_) renderer_->draw(pipe_);
+#endif
+  }
+  // Waits for the device's last step (and draw).
+  void finish() {
+    pipe_.max_displacement();
+#if DEFORMLAB_HAVE_GL
+    if (renderer_) renderer_->take_draw_ms();
+#endif
+  }
+
+ private:
+  Pipeline& pipe_;
+#if DEFORMLAB_HAVE_GL
+  std::unique_ptr<gl::Renderer> renderer_;
+#endif
+};
+
+// One step first: it bounds the cell's time before committing to it. Returns why the cell
+// is cut, else "".
+std::string cut_after_first_step(CellSteps& steps, const Sweep& s) {
+  const auto t0 = clock::now();
+  steps.step();
+  steps.finish();
+  const double first_s = std::chrono::duration<double>(clock::now() - t0).count();
+  const double expect_s = first_s * (s.warmup + double(s.steps) * s.repetitions);
+  if (expect_s <= s.cell_limit_s) return {};
+  std::ostringstream os;
+  os << "cut: the first step took " << first_s << " s, the cell would need about " << expect_s
+     << " s, over its limit of " << s.cell_limit_s << " s";
+  return os.str();
+}
+
+// The rest of the warm-up, then ms per step of each timed batch.
+std::vector<double> timed_batches(CellSteps& steps, const Sweep& s) {
+  for (int w = 1; w < s.warmup; ++w) steps.step();
+  steps.finish();
+  std::vector<double> ms_per_step;
+  for (int rep = 0; rep < s.repetitions; ++rep) {
+    const auto b0 = clock::now();
+    for (int st = 0; st < s.steps; ++st) steps.step();
+    steps.finish();
+    ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
+  }
+  return ms_per_step;
+}
+
+// One more batch with a profiler attached, for each stage's time per step; it is kept out
+// of the timed batches (a profiled CUDA pipeline runs pass by pass, not as a graph).
+json stage_times(Pipeline& pipe, CellSteps& steps, const Sweep& s) {
+  Profiler prof;
+  pipe.set_profiler(&prof);
+  for (int st = 1; st <= s.steps; ++st) {
+    prof.set_step(st);
+    steps.step();
+  }
+  steps.finish();
+  pipe.set_profiler(nullptr);
+  json stages = json::array();
+  for (const auto& g : prof.summary())
+    stages.push_back(
+        {{"name", g.name}, {"median_ms", g.median_ms}, {"clock", g.clock}, {"per_step", double(g.spans) / g.steps}});
+  return stages;
+}
+
+std::string method_of(const Sweep& s) {
+  const bool frame = s.time == "frame";
+  return "host steady_clock around " + std::to_string(s.steps) +
+         (frame ? " frames (a step and a 1024 x 1024 draw each)" : " steps") +
+         " closed by the pipeline's max-displacement reduction (which waits for the device), ms per " +
+         (frame ? "frame" : "step") + ", median of " + std::to_string(s.repetitions) + " batches after " +
+         std::to_string(s.warmup) + " warm-up steps";
+}
+
+// Times the cell on `pipe` from the rest state into `r`, or says why it was cut.
+json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
+  pipe.set_state(rest_state(m));
+  CellSteps steps(pipe, m, s.time);
+  if (auto why = cut_after_first_step(steps, s); !why.empty()) return not_applicable(r, why);
+  const std::vector<double> ms = timed_batches(steps, s);
+  const double d = pipe.max_displacement();
+  if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
+  r["status"] = "ok";
+  r["median_ms"] = median(ms);
+  r["min_ms"] = *std::min_element(ms.begin(), ms.end());
+  r["samples_ms"] = ms;
+  r["stable"] = d == d;
+  r["pipeline_timing"] = pipe.timing_method();
+  r["time"] = s.time;
+  r["method"] = method_of(s);
+  return r;
+}
+
+}  // namespace
+
+json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache) {
+  json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
+            {"options", c.options}};
+  const PipelineEntry& e = *pipelines().find(c.pipeline);
+  const Integrator integ = *parse_integrator(c.integrator);
+  if (auto why = e.unavailable(); !why.empty()) return not_applicable(r, why);
+  if (auto why = e.unsupported(integ); !why.empty()) return not_applicable(r, why);
+  Scene scene = x.scene;
+  if (auto why = size_model(scene, c, r); !why.empty()) return not_applicable(r, why);
+  try {
+    const Model& m = cached_model(cache, scene, c.size);
+    const Params p = resolve_params(scene, m);
+    auto pipe = e.make({m, p, integ, c.options});
+    return measure(r, *pipe, m, s);
+  } catch (const std::invalid_argument& ex) {
+    return not_applicable(r, ex.what());
+  } catch (const std::bad_alloc&) {
+    return not_applicable(r, "does not fit: out of host memory");
+  } catch (const std::exception& ex) {  // a pipeline failed (a driver error, a divergence)
+    return not_applicable(r, std::string("failed: ") + ex.what());
+  }
+}
+
+}  // namespace deformlab
