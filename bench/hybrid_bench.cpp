@@ -115,7 +115,7 @@ void run_hybrid(const HybridOptions& o) {
       print(r);
     }
     if (o.baselines) {
-      auto p = gl::make_tf_update(setup, nullptr);
+      auto p = gl::make_tf_pipeline(setup);
       p->set_state(rest_state(m));
       for (int s = 0; s < o.warmup; ++s) p->step();
       Row r{n, "glsl-tf", "-"};

@@ -10,13 +10,14 @@
 #include <limits>
 #include <stdexcept>
 
+#include "stage.hpp"
 #include "step_params.hpp"
 
 namespace deformlab {
 namespace {
 
 template <class Real>
-class CpuPipeline final : public Pipeline {
+class CpuPipeline final : public Pipeline, private ForceStage, private UpdateStage {
   using P = Physics<Real>;
   using V = Vec3<Real>;
   struct Slot {
@@ -73,14 +74,7 @@ class CpuPipeline final : public Pipeline {
   }
 
   void step() override {
-    for (const Pass& pass : sched_.passes) {
-      switch (pass.op) {
-        case Pass::Op::force: force(slots_[pass.src], acc_[pass.acc], t_ + pass.time_fraction * p_.dt); break;
-        case Pass::Op::combine: combine(pass); break;
-        case Pass::Op::update: update(); break;
-        case Pass::Op::solve: solve(); break;
-      }
-    }
+    run_passes(sched_, t_, p_.dt, *this, *this);
     constrain_and_commit();
   }
 
@@ -113,6 +107,17 @@ class CpuPipeline final : public Pipeline {
     return f;
   }
 
+  void forces(int src, int acc, double t) override { force(slots_[src], acc_[acc], t); }
+
+  void update(const Pass& pass) override {
+    switch (pass.op) {
+      case Pass::Op::combine: return combine(pass);
+      case Pass::Op::update: return one_pass();
+      case Pass::Op::solve: return solve();
+      case Pass::Op::force: throw std::logic_error("a force pass is not an update");
+    }
+  }
+
   void force(const Slot& s, std::vector<V>& a, double t) {
     const V target = sp_.drag_mode == DRAG_SPRING ? V(p_.drag.target(t)) : V{};
     for_nodes([&](int i) {
@@ -133,7 +138,7 @@ class CpuPipeline final : public Pipeline {
     });
   }
 
-  void update() {
+  void one_pass() {
     const Slot& s = slots_[0];
     const auto& a = acc_[0];
     for_nodes([&](int i) {

@@ -1,5 +1,5 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
-// and the device reductions (displacement, energy); and its force pass on its own, the force
+// and the device reductions (displacement, energy); and its force pass on its own, the CUDA
 // stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels.
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
@@ -15,7 +15,8 @@
 #include "check.cuh"
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
-#include "force_stage.hpp"
+#include "force_pass.hpp"
+#include "core/stage.hpp"
 #include "core/step_params.hpp"
 #include "kernels.cuh"
 
@@ -68,7 +69,7 @@ class ForceKernels {
   }
 
   // acc = a(x, v) for every node, queued on `stream`.
-  void forces(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
+  void launch_forces(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
     if (o_.variant == Variant::scatter) {
       check(cudaMemsetAsync(acc, 0, std::size_t(sp_.node_count) * sizeof(float4), stream), "clearing the force sums");
       const std::int64_t s = std::int64_t(springs_.size());
@@ -191,7 +192,7 @@ struct SpringEnergyOp {
   }
 };
 
-class Impl final : public CudaPipeline, private ForceKernels {
+class Impl final : public CudaPipeline, private ForceKernels, private ForceStage, private UpdateStage {
  public:
   Impl(const PipelineSetup& su, const Options& o)
       : ForceKernels(checked(su, o), su.params, o), p_(su.params), sched_(make_schedule(su.integrator)) {
@@ -336,9 +337,10 @@ class Impl final : public CudaPipeline, private ForceKernels {
   // The drag handle's targets do not change from step to step (none, or past its path).
   bool time_invariant() const { return !p_.drag.active() || t_ > p_.drag.end_time(); }
 
-  Targets targets(double time_fraction) const {
+  // The drag targets of a one-pass step: at its start (the forces) and at its end (the constraints).
+  Targets targets() const {
     if (!p_.drag.active()) return {};
-    return {p_.drag.target(t_ + time_fraction * p_.dt), p_.drag.target(t_ + p_.dt)};
+    return {p_.drag.target(t_), p_.drag.target(t_ + p_.dt)};
   }
 
   void capture(int parity) {
@@ -363,18 +365,22 @@ class Impl final : public CudaPipeline, private ForceKernels {
 
   void enqueue_step() {
     if (fused_) return timed(span::force_update, [&] { one_pass(true); });
-    for (const Pass& pass : sched_.passes) {
-      switch (pass.op) {
-        case Pass::Op::force:
-          timed(span::force, [&] { force_pass(pass.src, pass.acc, targets(pass.time_fraction).force); });
-          break;
-        case Pass::Op::combine:
-          if (sched_.single_pass()) timed(span::update, [&] { one_pass(false); });
-          else timed(span::update, [&] { combine_pass(pass); });
-          break;
-        case Pass::Op::update: timed(span::update, [&] { one_pass(false); }); break;
-        case Pass::Op::solve: throw std::logic_error("solve pass on a CUDA pipeline");
-      }
+    run_passes(sched_, t_, p_.dt, *this, *this);
+  }
+
+  void forces(int src, int acc, double t) override {
+    const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
+    timed(span::force, [&] { launch_forces(slot_x(src), slot_v(src), acc_[acc].get(), target, stream_); });
+  }
+
+  void update(const Pass& pass) override {
+    switch (pass.op) {
+      case Pass::Op::combine:
+        if (sched_.single_pass()) return timed(span::update, [&] { one_pass(false); });
+        return timed(span::update, [&] { combine_pass(pass); });
+      case Pass::Op::update: return timed(span::update, [&] { one_pass(false); });
+      case Pass::Op::solve: throw std::logic_error("solve pass on a CUDA pipeline");
+      case Pass::Op::force: throw std::logic_error("a force pass is not an update");
     }
   }
 
@@ -401,10 +407,6 @@ class Impl final : public CudaPipeline, private ForceKernels {
     return su.model;
   }
 
-  void force_pass(int src, int slot, Vec3f target) {
-    forces(slot_x(src), slot_v(src), acc_[slot].get(), target, stream_);
-  }
-
   // The result of a one-force-pass schedule: the update kernel after a force pass, or with
   // `fused` forces, update and constraints in one kernel.
   void one_pass(bool fused) {
@@ -421,7 +423,7 @@ class Impl final : public CudaPipeline, private ForceKernels {
     const float w = float(sched_.weight());
     const float4 *x = x_[cur_].get(), *v = v_[cur_].get(), *xp = x_[nxt].get();
     float4 *xo = x_[nxt].get(), *vo = v_[nxt].get();
-    const Targets tg = targets(0);
+    const Targets tg = targets();
     if (!fused) {
       dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), xp, has_prev_, xo, vo,
                                                                 tg.end);
@@ -454,7 +456,7 @@ class Impl final : public CudaPipeline, private ForceKernels {
     float4* xo = result ? x_[nxt].get() : sx_[pass.dst - 1].get();
     float4* vo = result ? v_[nxt].get() : sv_[pass.dst - 1].get();
     dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, result, xo, vo,
-                                                         targets(0).end);
+                                                         targets().end);
     check_launch("launching the combine kernel");
   }
 
@@ -478,11 +480,11 @@ class Impl final : public CudaPipeline, private ForceKernels {
 };
 
 // The force pass alone, on the current device (the hybrid pipelines' CUDA stage).
-class Stage final : public ForceStage, private ForceKernels {
+class DeviceForcePass final : public ForcePass, private ForceKernels {
  public:
-  Stage(const Model& m, const Params& p, const Options& o) : ForceKernels(m, p, o) {}
+  DeviceForcePass(const Model& m, const Params& p, const Options& o) : ForceKernels(m, p, o) {}
   void run(const float4* x, const float4* v, float4* acc, Vec3f drag_target, CUstream_st* stream) override {
-    forces(x, v, acc, drag_target, stream);
+    launch_forces(x, v, acc, drag_target, stream);
   }
 };
 
@@ -492,12 +494,12 @@ std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Option
   return std::make_unique<Impl>(s, o);
 }
 
-std::unique_ptr<ForceStage> make_force_stage(const Model& m, const Params& p, Variant v, Tile tile) {
+std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile) {
   if (v == Variant::fused) throw std::invalid_argument("cuda-fused is a whole step, not a force pass");
   if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
   validate(p, m.node_count());
   if (v == Variant::tiled || m.topology != Topology::general) check_tile(m, tile);
-  return std::make_unique<Stage>(m, p, Options{v, tile, false});
+  return std::make_unique<DeviceForcePass>(m, p, Options{v, tile, false});
 }
 
 }  // namespace deformlab::cuda

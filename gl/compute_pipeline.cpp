@@ -13,11 +13,11 @@ namespace {
 
 class ComputePipeline final : public GlPipeline {
  public:
-  ComputePipeline(const PipelineSetup& s, ExternalForces* forces)
-      : GlPipeline(s, forces ? "hybrid-compute" : "glsl-compute", forces) {
+  ComputePipeline(const PipelineSetup& s, const SharedAllocator& shared)
+      : GlPipeline(s, shared ? "hybrid-compute" : "glsl-compute", shared) {
     GLint blocks = 0;
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
-    const int need = forces ? 9 : 8;
+    const int need = shared ? 9 : 8;
     if (blocks < need)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
     GLint max_x = 0, max_y = 0;
@@ -56,8 +56,8 @@ std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s) {
   return std::make_unique<ComputePipeline>(s, nullptr);
 }
 
-std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, ExternalForces* forces) {
-  return std::make_unique<ComputePipeline>(s, forces);
+std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared) {
+  return std::make_unique<ComputePipeline>(s, shared);
 }
 
 }  // namespace deformlab::gl

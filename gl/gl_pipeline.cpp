@@ -24,8 +24,13 @@ static_assert(sizeof(P::StepParams) == 208 && sizeof(P::StencilEntry) == 32 && o
 
 }  // namespace
 
-GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces* forces)
-    : name_(std::move(name)), forces_(forces), m_(s.model), p_(s.params), rule_(info(s.integrator).rule) {
+GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared)
+    : name_(std::move(name)),
+      shared_(std::move(shared)),
+      m_(s.model),
+      p_(s.params),
+      rule_(info(s.integrator).rule),
+      sched_(make_schedule(s.integrator)) {
   context();
   n_ = m_.node_count();
   if (n_ < 1) throw std::invalid_argument(name_ + ": the model has no nodes");
@@ -37,9 +42,8 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces*
   if (adjacency > max_texels || n_ + 1 > max_texels)
     throw std::invalid_argument(name_ + ": the model needs texture buffers larger than this driver's " +
                                 std::to_string(max_texels) + " texels");
-  const Schedule sched = make_schedule(s.integrator);
-  plan(sched);
-  make_buffers(sched);
+  plan();
+  make_buffers();
   upload_params();
   if (!m_.grid()) upload_adjacency();
   const std::uint32_t zero = 0;
@@ -48,14 +52,14 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, ExternalForces*
 
 GlPipeline::~GlPipeline() = default;
 
-void GlPipeline::make_buffers(const Schedule& sched) {
+void GlPipeline::make_buffers() {
   const std::size_t bytes = std::size_t(n_) * 16;
-  // The states forces are evaluated at (and the accelerations) belong to the external
+  // The states forces are evaluated at (and the accelerations) belong to the outside
   // force stage when there is one.
   auto node_buffer = [&](bool forces_read) {
     NodeBuffer b;
-    if (forces_ && forces_read)
-      b.external = forces_->node_buffer(bytes, NodeRole::state);
+    if (shared_ && forces_read)
+      b.external = shared_(bytes, NodeRole::state);
     else
       b.buf = make_buffer(bytes);
     b.tex = make_texture_buffer(b.id(), GL_RGBA32F);
@@ -66,13 +70,13 @@ void GlPipeline::make_buffers(const Schedule& sched) {
     v_[k] = node_buffer(true);
     if (rule_ == UpdateRule::verlet) xp_[k] = node_buffer(false);
   }
-  for (int k = 0; k < sched.stage_states; ++k) {
+  for (int k = 0; k < sched_.stage_states; ++k) {
     sx_[k] = node_buffer(true);
     sv_[k] = node_buffer(true);
     sa_[k] = node_buffer(false);
   }
-  if (forces_) {
-    forces_acc_.external = forces_->node_buffer(bytes, NodeRole::accelerations);
+  if (shared_) {
+    forces_acc_.external = shared_(bytes, NodeRole::accelerations);
     forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
   }
 }
@@ -102,7 +106,8 @@ void GlPipeline::upload_adjacency() {
 }
 
 // One GPU pass per force pass of the schedule, with the update that follows it.
-void GlPipeline::plan(const Schedule& s) {
+void GlPipeline::plan() {
+  const Schedule& s = sched_;
   if (s.rule == UpdateRule::backward_euler)
     throw std::invalid_argument(name_ + ": " + std::string(info(s.integrator).name) + " is not available on " + name_);
   for (std::size_t k = 0; k + 1 < s.passes.size(); k += 2) {
@@ -124,7 +129,7 @@ void GlPipeline::init() {
   static const char* kind_define[] = {"PASS_ONE", "PASS_STAGE", "PASS_RESULT"};
   const std::string common = "#define RULE " + std::to_string(int(rule_)) + "\n" +
                              (m_.grid() ? "#define TOPOLOGY_GRID 1\n" : "#define TOPOLOGY_GENERAL 1\n") +
-                             (forces_ ? "#define EXTERNAL_FORCES 1\n" : "");
+                             (shared_ ? "#define EXTERNAL_FORCES 1\n" : "");
   for (GpuPass& g : passes_) {
     const int outputs = g.kind == PassKind::stage || rule_ == UpdateRule::verlet ? 3 : 2;
     g.prog = make_program(outputs, std::string("#define PASS ") + kind_define[int(g.kind)] + "\n#define STAGE " +
@@ -173,6 +178,7 @@ void GlPipeline::set_state(const State& s) {
   glMemoryBarrier(GL_ALL_BARRIER_BITS);
   t_ = s.t;
   stepped_ = false;
+  next_pass_ = 0;
   on_set_state();
   check(name_ + " set_state");
 }
@@ -214,56 +220,71 @@ void GlPipeline::bind_textures(int stage) const {
 }
 
 void GlPipeline::step() {
-  const bool debug = context().debug;
-  const int c = cur_, d = 1 - cur_;
-  const double dt = p_.dt;
-  const Vec3f next = p_.drag.active() ? p_.drag.target(t_ + dt) : Vec3f{};
-  // With an external force stage, it times the passes (GL timer spans may not nest).
-  const bool timed = prof_ && !forces_;
+  // With an outside force stage, its pipeline times the passes (GL timer spans may not nest).
+  const bool timed = prof_ && !shared_;
   if (timed) {
     if (spans_.pending() >= 512) spans_.collect(prof_);
     spans_.begin(*prof_, span::force_update);
   }
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
-  for (const GpuPass& g : passes_) {
-    const GLuint id = g.prog.id();
-    const Vec3f target = p_.drag.active() ? p_.drag.target(t_ + g.time_fraction * dt) : Vec3f{};
-    glProgramUniform3f(id, g.drag_force_target, target.x, target.y, target.z);
-    glProgramUniform3f(id, g.drag_next, next.x, next.y, next.z);
-    glProgramUniform1i(id, g.has_prev, has_prev_ ? 1 : 0);
-    bind_textures(g.stage);
-    PassIO io{};
-    io.set = c;
-    io.s0_x = &x_[c];
-    io.s0_v = &v_[c];
-    io.s0_p = &xp_[c];
-    io.src_x = g.stage == 0 ? &x_[c] : &sx_[g.stage - 1];
-    io.src_v = g.stage == 0 ? &v_[c] : &sv_[g.stage - 1];
-    if (g.kind == PassKind::stage) {
-      io.out = {&sa_[g.stage], &sx_[g.stage], &sv_[g.stage]};
-      io.outputs = 3;
-    } else {
-      io.out = {&x_[d], &v_[d], &xp_[d]};
-      io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
-    }
-    if (forces_) {
-      forces_->forces(io.src_x->id(), io.src_v->id(), forces_acc_.id(), t_ + g.time_fraction * dt);
-      io.forces_acc = &forces_acc_;
-    }
-    run_pass(id, io);
-    if (forces_) forces_->update_issued();
-    if (debug) check_debug(name_ + " pass " + std::to_string(&g - passes_.data()));  // no string otherwise
-  }
+  run_passes(sched_, t_, p_.dt, *this, *this);
   if (timed) spans_.end();
+  finish_step();
+}
+
+void GlPipeline::forces(int src, int acc, double t) {
+  if (shared_ || src != acc || std::size_t(src) != next_pass_)
+    throw std::logic_error(name_ + ": force pass out of the order of its GPU passes");
+  force_t_ = t;
+}
+
+void GlPipeline::update(const Pass& pass) {
+  if (next_pass_ >= passes_.size() || pass.op == Pass::Op::force)
+    throw std::logic_error(name_ + ": update pass out of the order of its GPU passes");
+  const GpuPass& g = passes_[next_pass_++];
+  const int c = cur_, d = 1 - cur_;
+  const GLuint id = g.prog.id();
+  const Vec3f target = p_.drag.active() ? p_.drag.target(force_t_) : Vec3f{};
+  const Vec3f next = p_.drag.active() ? p_.drag.target(t_ + p_.dt) : Vec3f{};
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
+  glProgramUniform3f(id, g.drag_force_target, target.x, target.y, target.z);
+  glProgramUniform3f(id, g.drag_next, next.x, next.y, next.z);
+  glProgramUniform1i(id, g.has_prev, has_prev_ ? 1 : 0);
+  bind_textures(g.stage);
+  PassIO io{};
+  io.set = c;
+  io.s0_x = &x_[c];
+  io.s0_v = &v_[c];
+  io.s0_p = &xp_[c];
+  io.src_x = g.stage == 0 ? &x_[c] : &sx_[g.stage - 1];
+  io.src_v = g.stage == 0 ? &v_[c] : &sv_[g.stage - 1];
+  if (g.kind == PassKind::stage) {
+    io.out = {&sa_[g.stage], &sx_[g.stage], &sv_[g.stage]};
+    io.outputs = 3;
+  } else {
+    io.out = {&x_[d], &v_[d], &xp_[d]};
+    io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
+  }
+  if (shared_) io.forces_acc = &forces_acc_;
+  run_pass(id, io);
+  if (context().debug) check_debug(name_ + " pass " + std::to_string(&g - passes_.data()));  // no string otherwise
+}
+
+void GlPipeline::finish_step() {
+  if (next_pass_ != passes_.size()) throw std::logic_error(name_ + ": step finished before its last pass");
   check(name_ + " step");
-  cur_ = d;
-  t_ += dt;
+  next_pass_ = 0;
+  cur_ = 1 - cur_;
+  t_ += p_.dt;
   stepped_ = true;
   if (rule_ == UpdateRule::verlet) has_prev_ = true;
 }
 
+std::array<GLuint, 2> GlPipeline::slot_buffers(int slot) const {
+  return slot == 0 ? std::array{x_[cur_].id(), v_[cur_].id()} : std::array{sx_[slot - 1].id(), sv_[slot - 1].id()};
+}
+
 void GlPipeline::set_profiler(Profiler* p) {
-  if (forces_) return;  // the external force stage times the passes
+  if (shared_) return;  // the outside force stage's pipeline times the passes
   spans_.collect(prof_);
   prof_ = p;
 }

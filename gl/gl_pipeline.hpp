@@ -3,44 +3,49 @@
 // differ only in how a pass runs (transform feedback or compute shader).
 #pragma once
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/pipeline.hpp"
+#include "core/stage.hpp"
 #include "objects.hpp"
 
 namespace deformlab::gl {
 
-// Forces from outside the GL layer (the hybrid pipelines): another stage writes each node's
-// acceleration into a GL buffer that the update passes read instead of evaluating forces.
+// Buffers that a force stage outside GL shares with it (the hybrid pipelines): it allocates
+// the states the forces are evaluated at (it reads them) and the accelerations (it writes them).
 enum class NodeRole { state, accelerations };
-class ExternalForces {
- public:
-  virtual ~ExternalForces() = default;
-  // A GL buffer of `bytes` that the force stage owns: a state the forces are evaluated at
-  // (the stage reads it) or the accelerations (the stage writes them).
-  virtual GLuint node_buffer(std::size_t bytes, NodeRole role) = 0;
-  // Before each update pass: acc = a(x, v) at time t. GL commands issued before this call
-  // wrote x and v; those issued after it read acc.
-  virtual void forces(GLuint x, GLuint v, GLuint acc, double t) = 0;
-  // After each update pass was issued.
-  virtual void update_issued() {}
-};
+using SharedAllocator = std::function<GLuint(std::size_t bytes, NodeRole role)>;
 
-class GlPipeline : public Pipeline {
+class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
  public:
   ~GlPipeline() override;
   void set_state(const State& s) override;
   State state() override;
-  void step() override;
+  void step() override;  // the schedule's passes with the forces in the shaders, then finish_step()
+  // The shaders evaluate a force pass inside the GPU pass of the update that follows it:
+  // this records the time of those forces.
+  void forces(int src, int acc, double t) override;
+  // The schedule's next GPU pass: the forces (or, with an outside force stage, the
+  // accelerations it wrote) and this update.
+  void update(const Pass& pass) override;
+  // After a step's last pass: the result becomes the current state.
+  void finish_step();
+  double time() const { return t_; }
+
+  // For an outside force stage: the positions and velocities of state slot `slot` (GL wrote
+  // them before the stage runs) and the accelerations it writes (GL reads them after).
+  std::array<GLuint, 2> slot_buffers(int slot) const;
+  GLuint force_buffer() const { return forces_acc_.id(); }
   double max_displacement() override;
   std::string timing_method() const override { return spans_.method(); }
 
   // The current positions, one vec4 per node (w: inverse mass), ready to be read by GL.
   GLuint position_buffer();
   // While profiled, each step's passes are one force+update span timed by the GL clock
-  // (without an external force stage, which times the passes itself).
+  // (without an outside force stage, whose pipeline times the passes itself).
   void set_profiler(Profiler* p) override;
   // "grid arithmetic" or "adjacency buffer": how the shaders find a node's springs.
   std::string neighbour_mode() const { return m_.grid() ? "grid arithmetic" : "adjacency buffer"; }
@@ -63,11 +68,12 @@ class GlPipeline : public Pipeline {
     const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v;
     std::array<const NodeBuffer*, 3> out;
     int outputs;
-    const NodeBuffer* forces_acc;  // accelerations from the external force stage, else null
+    const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
   };
 
-  // With `forces`, the passes read accelerations from it instead of evaluating forces.
-  GlPipeline(const PipelineSetup& s, std::string name, ExternalForces* forces = nullptr);
+  // With `shared`, the passes read accelerations that an outside force stage writes into
+  // buffers it allocates, instead of evaluating forces.
+  GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared = {});
   // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
   void init();
   // `defines` selects the pass kind, its stage, the update rule and the neighbour mode (see
@@ -79,8 +85,8 @@ class GlPipeline : public Pipeline {
 
   int n_ = 0;
   const std::string name_;
-  ExternalForces* const forces_;
-  NodeBuffer forces_acc_;  // what the external force stage writes
+  const SharedAllocator shared_;
+  NodeBuffer forces_acc_;  // what the outside force stage writes
   std::array<NodeBuffer, 2> x_, v_, xp_;  // state sets, ping-pong (xp_: Verlet)
   // Runge-Kutta stages: sx_[k], sv_[k] the state of stage k + 1, sa_[k] the acceleration at stage k.
   std::array<NodeBuffer, kMaxStages - 1> sx_, sv_, sa_;
@@ -94,16 +100,19 @@ class GlPipeline : public Pipeline {
     Program prog;
     GLint drag_force_target, drag_next, has_prev;
   };
-  void make_buffers(const Schedule& s);
+  void make_buffers();
   void upload_params();
   void upload_adjacency();
-  void plan(const Schedule& s);
+  void plan();
   void bind_textures(int stage) const;  // earlier stages' slopes and the adjacency
 
   const Model& m_;
   const Params p_;
   const UpdateRule rule_;
+  Schedule sched_;
   std::vector<GpuPass> passes_;
+  std::size_t next_pass_ = 0;  // of this step
+  double force_t_ = 0.0;       // of the forces of the next pass
   Buffer params_ubo_, adj_offset_, links_, result_;
   Texture adj_offset_tex_, links_tex_;
   Program reduce_, copy_;

@@ -11,8 +11,8 @@ namespace {
 
 class TfPipeline final : public GlPipeline {
  public:
-  TfPipeline(const PipelineSetup& s, ExternalForces* forces)
-      : GlPipeline(s, forces ? "hybrid" : "glsl-tf", forces) {
+  TfPipeline(const PipelineSetup& s, const SharedAllocator& shared)
+      : GlPipeline(s, shared ? "hybrid" : "glsl-tf", shared) {
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
     if (separate < 3) throw std::invalid_argument(name_ + " needs 3 separate transform feedback buffers");
@@ -98,8 +98,8 @@ class TfPipeline final : public GlPipeline {
 
 std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s) { return std::make_unique<TfPipeline>(s, nullptr); }
 
-std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, ExternalForces* forces) {
-  return std::make_unique<TfPipeline>(s, forces);
+std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared) {
+  return std::make_unique<TfPipeline>(s, shared);
 }
 
 }  // namespace deformlab::gl

@@ -3,7 +3,8 @@
 #include <stdexcept>
 
 #include "cuda_kernels/event_spans.hpp"
-#include "cuda_kernels/force_stage.hpp"
+#include "core/stage.hpp"
+#include "cuda_kernels/force_pass.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 #include "hybrid.hpp"
@@ -38,67 +39,19 @@ std::string hybrid_unsupported(Integrator i) {
 
 namespace {
 
-// The CUDA side of a hybrid step: hand-off to CUDA, the force pass, hand-off back to GL;
-// and the timing of each stage with its own clock when a profiler is attached.
-class HybridForces final : public gl::ExternalForces {
+// The CUDA force stage and the GL update stage run by the schedule: each force pass hands the
+// state to CUDA, runs the force kernels and hands the accelerations back to GL; each update
+// pass is a GL pass. With a profiler attached, each stage is timed with its own clock.
+class HybridPipeline final : public Pipeline, private ForceStage, private UpdateStage {
  public:
-  HybridForces(const Params& p, SharedBuffers& sb, cuda::ForceStage& fs) : p_(p), sb_(sb), fs_(fs) {}
-
-  GLuint node_buffer(std::size_t bytes, gl::NodeRole role) override {
-    return sb_.add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
-  }
-
-  void forces(GLuint x, GLuint v, GLuint acc, double t) override {
-    const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
-    {
-      HostSpan h(prof_, span::hand_off);
-      sb_.to_cuda({x, v, acc});
-    }
-    if (prof_) force_spans_.begin(*prof_, span::force, sb_.stream());
-    fs_.run(static_cast<const float4*>(sb_.cuda_ptr(x)), static_cast<const float4*>(sb_.cuda_ptr(v)),
-            static_cast<float4*>(sb_.cuda_ptr(acc)), target, sb_.stream());
-    if (prof_) force_spans_.end(sb_.stream());
-    {
-      HostSpan h(prof_, span::hand_off);
-      sb_.to_gl();
-    }
-    if (prof_) update_spans_.begin(*prof_, span::update);
-  }
-
-  void update_issued() override {
-    if (!prof_) return;
-    update_spans_.end();
-    if (force_spans_.pending() > 512) collect();
-  }
-
-  // Spans still pending go to the profiler they were taken for.
-  void set_profiler(Profiler* p) {
-    collect();
-    prof_ = p;
-  }
-
- private:
-  void collect() {
-    force_spans_.collect(prof_);
-    update_spans_.collect(prof_);
-  }
-
-  const Params& p_;
-  SharedBuffers& sb_;
-  cuda::ForceStage& fs_;
-  Profiler* prof_ = nullptr;
-  cuda::EventSpans force_spans_;
-  gl::TimerSpans update_spans_;
-};
-
-class HybridPipeline final : public Pipeline {
- public:
-  HybridPipeline(const PipelineSetup& s, const HybridOptions& o) : p_(s.params) {
+  HybridPipeline(const PipelineSetup& s, const HybridOptions& o) : p_(s.params), sched_(make_schedule(s.integrator)) {
     if (const std::string why = hybrid_unsupported(s.integrator); !why.empty()) throw std::invalid_argument(why);
     sb_ = make_shared_buffers(o.mode);  // selects the CUDA device behind the GL context
-    fs_ = cuda::make_force_stage(s.model, p_, o.force, o.tile);
-    forces_ = std::make_unique<HybridForces>(p_, *sb_, *fs_);
-    gl_ = o.update == Update::compute ? gl::make_compute_update(s, forces_.get()) : gl::make_tf_update(s, forces_.get());
+    fp_ = cuda::make_force_pass(s.model, p_, o.force, o.tile);
+    auto shared = [this](std::size_t bytes, gl::NodeRole role) {
+      return sb_->add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
+    };
+    gl_ = o.update == Update::compute ? gl::make_compute_update(s, shared) : gl::make_tf_update(s, shared);
   }
 
   ~HybridPipeline() override {
@@ -108,20 +61,59 @@ class HybridPipeline final : public Pipeline {
 
   void set_state(const State& s) override { gl_->set_state(s); }
   State state() override { return gl_->state(); }
-  void step() override { gl_->step(); }
+  void step() override {
+    run_passes(sched_, gl_->time(), p_.dt, *this, *this);
+    gl_->finish_step();
+    if (prof_ && force_spans_.pending() > 512) collect();
+  }
   double max_displacement() override { return gl_->max_displacement(); }
   std::string timing_method() const override {
     return "host clock per step; stages: CUDA events (force), " + gl::Timer().method() +
            " (update), host clock (hand-off)";
   }
-  void set_profiler(Profiler* p) override { forces_->set_profiler(p); }
+  // Spans still pending go to the profiler they were taken for.
+  void set_profiler(Profiler* p) override {
+    collect();
+    prof_ = p;
+  }
 
  private:
+  void forces(int src, int acc, double t) override {
+    (void)acc;  // one acceleration buffer: each update pass keeps what later passes need
+    const auto [x, v] = gl_->slot_buffers(src);
+    const GLuint a = gl_->force_buffer();
+    const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
+    {
+      HostSpan h(prof_, span::hand_off);
+      sb_->to_cuda({x, v, a});
+    }
+    if (prof_) force_spans_.begin(*prof_, span::force, sb_->stream());
+    fp_->run(static_cast<const float4*>(sb_->cuda_ptr(x)), static_cast<const float4*>(sb_->cuda_ptr(v)),
+             static_cast<float4*>(sb_->cuda_ptr(a)), target, sb_->stream());
+    if (prof_) force_spans_.end(sb_->stream());
+    HostSpan h(prof_, span::hand_off);
+    sb_->to_gl();
+  }
+
+  void update(const Pass& pass) override {
+    if (prof_) update_spans_.begin(*prof_, span::update);
+    gl_->update(pass);
+    if (prof_) update_spans_.end();
+  }
+
+  void collect() {
+    force_spans_.collect(prof_);
+    update_spans_.collect(prof_);
+  }
+
   Params p_;
+  Schedule sched_;
+  Profiler* prof_ = nullptr;
+  cuda::EventSpans force_spans_;
+  gl::TimerSpans update_spans_;
   // Destroyed in reverse: the GL pipeline first, the shared buffers (and their stream) last.
   std::unique_ptr<SharedBuffers> sb_;
-  std::unique_ptr<cuda::ForceStage> fs_;
-  std::unique_ptr<HybridForces> forces_;
+  std::unique_ptr<cuda::ForcePass> fp_;
   std::unique_ptr<gl::GlPipeline> gl_;
 };
 

@@ -19,7 +19,7 @@ summary=()
 
 ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
 summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
-grep -E "Label|^ *(unit|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
+grep -E "Label|^ *(unit|match|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
 
 cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
 if [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then

@@ -24,12 +24,6 @@ inline Model as_general(Model m) {
   return m;
 }
 
-inline bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)) == 0);
-}
-inline bool bitwise_equal(const State& a, const State& b) {
-  return bitwise_equal(a.x, b.x) && bitwise_equal(a.v, b.v) && bitwise_equal(a.x_prev, b.x_prev) && a.t == b.t;
-}
 
 inline double max_abs_position(const State& s) {
   double m = 0;

@@ -1,11 +1,13 @@
-// The GL update passes fed by an outside force stage (what the hybrid pipelines do with
-// CUDA), here with the accelerations computed on the host from the state GL wrote, so that
-// the GL side of the hybrid step is checked on any GL driver (llvmpipe in CI). Tolerance:
+// The GL update passes fed by an outside force stage and driven by the schedule runner (what
+// the hybrid pipelines do with CUDA), here with the accelerations computed on the host from
+// the state GL wrote, so that the GL side of the hybrid step is checked on any GL driver
+// (llvmpipe in CI). Tolerance:
 // as for the hybrid pipelines (hybrid_test.cpp): 8 x the CPU float pipeline's own distance
 // from the double reference, with a floor of 1e-6 m and 1e-4 m/s.
 #include <gtest/gtest.h>
 
 #include "core/cpu_backend.hpp"
+#include "core/stage.hpp"
 #include "core/step_params.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
@@ -16,16 +18,20 @@ namespace {
 
 // Accelerations on the host with the per-node physics (core/node_physics.h), summed in
 // adjacency order.
-class HostForces final : public gl::ExternalForces {
+class HostForces final : public ForceStage {
  public:
   HostForces(const Model& m, const Params& p) : m_(m), p_(p) {}
 
-  GLuint node_buffer(std::size_t bytes, gl::NodeRole) override {
-    buffers_.push_back(gl::make_buffer(bytes));
-    return buffers_.back().id();
+  gl::SharedAllocator allocator() {
+    return [this](std::size_t bytes, gl::NodeRole) {
+      buffers_.push_back(gl::make_buffer(bytes));
+      return buffers_.back().id();
+    };
   }
+  void attach(gl::GlPipeline* gl) { gl_ = gl; }
 
-  void forces(GLuint x, GLuint v, GLuint acc, double t) override {
+  void forces(int src, int, double t) override {
+    const auto [x, v] = gl_->slot_buffers(src);
     const std::size_t n = std::size_t(m_.node_count());
     std::vector<float> xs(4 * n), vs(4 * n), a(4 * n, 0.f);
     gl::read_buffer(x, xs.size() * 4, xs.data());
@@ -46,7 +52,7 @@ class HostForces final : public gl::ExternalForces {
       a[4 * i + 1] = ai.y;
       a[4 * i + 2] = ai.z;
     }
-    glNamedBufferSubData(acc, 0, GLsizeiptr(a.size() * 4), a.data());
+    glNamedBufferSubData(gl_->force_buffer(), 0, GLsizeiptr(a.size() * 4), a.data());
     ++calls;
   }
 
@@ -55,6 +61,7 @@ class HostForces final : public gl::ExternalForces {
  private:
   const Model& m_;
   const Params& p_;
+  gl::GlPipeline* gl_ = nullptr;
   std::vector<gl::Buffer> buffers_;
 };
 
@@ -70,21 +77,23 @@ TEST_P(GlUpdatePass, MatchesTheCpuPipeline) {
   const Case& c = GetParam();
   Model m = small_cloth(16, 12);
   m.damping = {0.02f, 0.02f, 0.01f};
-  Params p = small_params();
-  if (c.integrator == Integrator::explicit_euler) p.dt = 1e-4f;
-  p.wind = {0.002f, 0.f, -0.001f};
-  p.drag.node = m.node_count() / 2 + 3;
-  p.drag.as_spring = true;
-  p.drag.stiffness = 50.f;
-  p.drag.path = {{0.f, m.rest_position[p.drag.node]}, {0.1f, m.rest_position[p.drag.node] + Vec3f{0.05f, 0.02f, 0.f}}};
+  const Params p = moving_params(m, c.integrator);
   const State s0 = perturbed_state(m, 11);
   const int steps = 30;
   const PipelineSetup setup{m, p, c.integrator};
   HostForces forces(m, p);
-  auto gpu = c.compute ? gl::make_compute_update(setup, &forces) : gl::make_tf_update(setup, &forces);
+  auto gpu = c.compute ? gl::make_compute_update(setup, forces.allocator()) : gl::make_tf_update(setup, forces.allocator());
+  forces.attach(gpu.get());
+  gpu->set_state(s0);
+  const Schedule sched = make_schedule(c.integrator);
+  for (int k = 0; k < steps; ++k) {
+    run_passes(sched, gpu->time(), p.dt, forces, *gpu);
+    gpu->finish_step();
+  }
+  const State g = gpu->state();
   auto f32 = make_cpu_pipeline(setup, Precision::f32, false);
   auto f64 = make_cpu_pipeline(setup, Precision::f64, false);
-  const State g = advance(*gpu, s0, steps), a = advance(*f32, s0, steps), r = advance(*f64, s0, steps);
+  const State a = advance(*f32, s0, steps), r = advance(*f64, s0, steps);
   EXPECT_EQ(forces.calls, steps * info(c.integrator).force_passes);
   const double tol_x = std::max(8.0 * max_position_diff(a, r), 1e-6);
   const double tol_v = std::max(8.0 * max_velocity_diff(a, r), 1e-4);

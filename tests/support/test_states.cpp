@@ -1,6 +1,8 @@
 #include "test_states.hpp"
 
 #include <algorithm>
+#include <cstring>
+#include <limits>
 #include <random>
 
 namespace deformlab::test {
@@ -36,16 +38,35 @@ State perturbed_state(const Model& m, std::uint32_t seed, float pos_amp, float v
   return s;
 }
 
-double max_position_diff(const State& a, const State& b) {
+Params moving_params(const Model& m, Integrator i) {
+  Params p = small_params();
+  if (i == Integrator::explicit_euler) p.dt = 1e-4f;
+  p.wind = {0.002f, 0.f, -0.001f};
+  if (m.node_count() > 20) {
+    p.drag.node = m.node_count() / 2 + 3;
+    p.drag.as_spring = true;
+    p.drag.stiffness = 50.f;
+    const Vec3f x0 = m.rest_position[p.drag.node];
+    p.drag.path = {{0.f, x0}, {0.1f, x0 + Vec3f{0.05f, 0.02f, 0.f}}};
+  }
+  return p;
+}
+
+double max_diff(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
   double d = 0.0;
-  for (std::size_t i = 0; i < a.x.size(); ++i) d = std::max(d, double(norm(a.x[i] - b.x[i])));
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, double(norm(a[i] - b[i])));
   return d;
 }
 
-double max_velocity_diff(const State& a, const State& b) {
-  double d = 0.0;
-  for (std::size_t i = 0; i < a.v.size(); ++i) d = std::max(d, double(norm(a.v[i] - b.v[i])));
-  return d;
+double max_position_diff(const State& a, const State& b) { return max_diff(a.x, b.x); }
+double max_velocity_diff(const State& a, const State& b) { return max_diff(a.v, b.v); }
+
+bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)) == 0);
+}
+bool bitwise_equal(const State& a, const State& b) {
+  return bitwise_equal(a.x, b.x) && bitwise_equal(a.v, b.v) && bitwise_equal(a.x_prev, b.x_prev) && a.t == b.t;
 }
 
 State advance(Pipeline& p, const State& s0, int steps) {

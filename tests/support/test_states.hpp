@@ -2,6 +2,7 @@
 #pragma once
 #include <cstdint>
 
+#include "core/integrator.hpp"
 #include "core/model.hpp"
 #include "core/params.hpp"
 #include "core/pipeline.hpp"
@@ -17,13 +18,22 @@ Model small_lattice(int nx, int ny, int nz, bool pinned = true);
 // the caller if wanted, no colliders, no drag.
 Params small_params();
 
+// small_params() with wind and, on models of more than 20 nodes, a free node pulled along a
+// path by a drag spring; explicit Euler gets dt = 0.1 ms (at 1 ms it grows ~1.4x per step on
+// these springs). The scene of the tests that compare pipelines.
+Params moving_params(const Model& m, Integrator i);
+
 // The rest state moved off rest and set moving: positions jittered by up to `pos_amp`
 // (m) and velocities up to `vel_amp` (m/s), from a fixed seed (deterministic).
 State perturbed_state(const Model& m, std::uint32_t seed, float pos_amp = 0.01f, float vel_amp = 0.2f);
 
-// Largest |a.x - b.x| and |a.v - b.v| over nodes.
+// Largest |a[i] - b[i]| over nodes (infinite when the sizes differ); of positions, of velocities.
+double max_diff(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
 double max_position_diff(const State& a, const State& b);
 double max_velocity_diff(const State& a, const State& b);
+// Equal bit for bit (positions, velocities, previous positions, time).
+bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
+bool bitwise_equal(const State& a, const State& b);
 
 // Runs `steps` steps of a pipeline made by `make` from state `s0` and returns the state.
 State advance(Pipeline& p, const State& s0, int steps);

@@ -40,7 +40,9 @@ TEST(GridStencil, EveryNeighbourOnceIncomingThenOwn) {
         }
         EXPECT_TRUE(negated) << "entry " << e;
         // by decreasing linear offset of the own offset they negate
-        if (e > 0) EXPECT_GT(linear(o), linear(grid_offset(volume, e - 1)));
+        if (e > 0) {
+          EXPECT_GT(linear(o), linear(grid_offset(volume, e - 1)));
+        }
       }
     }
     EXPECT_EQ(int(seen.size()), volume ? 32 : 12);  // cloth: 4 + 4 + 4; lattice: 6 + 20 + 6

@@ -1,5 +1,6 @@
-// The CUDA pipelines' force pass on its own, for pipelines that run the rest of the step
-// elsewhere (the hybrid pipelines update in GL). Plain C++: includable without nvcc.
+// The CUDA pipelines' force pass on its own, over device arrays that another API may own:
+// what the hybrid pipelines' force stage runs (interop/hybrid_pipeline.cpp). Plain C++:
+// includable without nvcc.
 #pragma once
 #include <memory>
 
@@ -10,9 +11,9 @@ struct CUstream_st;
 
 namespace deformlab::cuda {
 
-class ForceStage {
+class ForcePass {
  public:
-  virtual ~ForceStage() = default;
+  virtual ~ForcePass() = default;
   // acc = a(x, v) for every node, queued on `stream`: x positions (w: inverse mass), v
   // velocities, acc accelerations; float4 arrays of the model's node count on the current
   // device. `drag_target`: the drag handle's target at the time of the forces.
@@ -21,6 +22,6 @@ class ForceStage {
 
 // The naive, tiled or scatter force pass on the current device; throws std::invalid_argument
 // for fused (not a force pass), a bad tile or a model that does not fit.
-std::unique_ptr<ForceStage> make_force_stage(const Model& m, const Params& p, Variant v, Tile tile);
+std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile);
 
 }  // namespace deformlab::cuda

@@ -1,0 +1,143 @@
+// Every pipeline in the registry against the CPU float pipeline (`cpu`), for every
+// integrator it runs, on every model shape below: 50 steps from a perturbed, moving state
+// with wind, spring damping and a drag spring. Pipelines that a build or machine lacks skip
+// with the reason; `reference` (double) is the yardstick, not a subject.
+//
+// What each pipeline promises is its registry trait (core/pipeline.hpp, PipelineTraits):
+// - bitwise: the same float operations in the same order as `cpu` (omp, the CUDA gather
+//   kernels: no FMA contraction, the same stencil and adjacency order): equal states, bit
+//   for bit, and the same stop-rule displacement;
+// - rounding: the same formulas with other roundings (GLSL may contract a*b+c and sum in
+//   another order; the scatter kernels add in atomic order). Those differences are the size
+//   float rounding itself makes, so they are held to 8 x the `cpu` pipeline's own distance
+//   from the double reference on this very trajectory, with a floor of a few ulp of the
+//   coordinates (1 m scale: 1e-6 m, 1e-4 m/s). Measured: at most 2.5x on llvmpipe; a real
+//   fault (a missing spring, a stale buffer after a hand-off) shows as 1e-3 m and more.
+// Deterministic pipelines also repeat their own bits on a second run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/cpu_backend.hpp"
+#include "experiments/pipelines.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+struct Shape {
+  const char* name;
+  int nx, ny, nz;  // nz > 0: lattice
+  bool damped;
+  bool general = false;  // the same springs without the grid: the adjacency paths
+};
+const Shape kShapes[] = {
+    {"cloth32", 32, 32, 0, true},       {"cloth37x53", 37, 53, 0, false},  // not a multiple of any tile
+    {"cloth2x3", 2, 3, 0, true},        {"lattice6x5x4", 6, 5, 4, true},
+    {"lattice3x4x5", 3, 4, 5, false},  // too narrow for the interior stencil anywhere
+    {"general32", 32, 32, 0, true, true},
+};
+
+// Option values tried beyond the defaults, by option name (PipelineEntry::options).
+const std::pair<const char*, std::vector<std::string>> kOptionValues[] = {
+    {"force", {"tiled", "scatter"}},
+    {"interop", {"external", "external-gpusync", "staged"}},
+};
+
+struct Case {
+  std::string pipeline;
+  Integrator integrator;
+  int shape;
+  PipelineOptions options = {};
+};
+
+std::string case_name(const testing::TestParamInfo<Case>& p) {
+  const Case& c = p.param;
+  std::string s = c.pipeline + "_" + std::string(info(c.integrator).name) + "_" + kShapes[c.shape].name;
+  for (const auto& [k, v] : c.options) s += "_" + k + "_" + v;
+  for (char& ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return s;
+}
+
+Model make_model(const Shape& s) {
+  Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny);
+  if (s.damped) m.damping = {0.02f, 0.02f, 0.01f};
+  if (s.general) m.topology = Topology::general;
+  return m;
+}
+
+constexpr int kSteps = 50;
+
+class MatchCpu : public testing::TestWithParam<Case> {};
+
+TEST_P(MatchCpu, FiftyStepsFromAMovingState) {
+  const Case& c = GetParam();
+  const PipelineEntry& e = *pipelines().find(c.pipeline);
+  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  const Model m = make_model(kShapes[c.shape]);
+  const Params p = moving_params(m, c.integrator);
+  const State s0 = perturbed_state(m, 7u + unsigned(c.shape));
+  const PipelineSetup setup{m, p, c.integrator, c.options};
+
+  auto subject = e.make(setup);
+  const State g = advance(*subject, s0, kSteps);
+  const double g_disp = subject->max_displacement();
+  auto cpu = make_cpu_pipeline(setup, Precision::f32, false);
+  const State a = advance(*cpu, s0, kSteps);
+  const double a_disp = cpu->max_displacement();
+  ASSERT_GT(max_position_diff(a, s0), 1e-4) << "the scene must move";
+
+  const bool scatter = c.options.contains("force") && c.options.at("force") == "scatter";
+  if (e.traits.cpu_match == CpuMatch::bitwise) {
+    EXPECT_TRUE(bitwise_equal(g, a)) << "|x - x_cpu| = " << max_position_diff(g, a) << " m, |v - v_cpu| = "
+                                     << max_velocity_diff(g, a) << " m/s";
+    EXPECT_EQ(g_disp, a_disp);
+  } else {
+    auto ref = make_cpu_pipeline(setup, Precision::f64, false);
+    const State r = advance(*ref, s0, kSteps);
+    const double rounding_x = max_position_diff(a, r), rounding_v = max_velocity_diff(a, r);
+    const double dx = max_position_diff(g, a), dv = max_velocity_diff(g, a);
+    const double tol_x = std::max(8.0 * rounding_x, 1e-6), tol_v = std::max(8.0 * rounding_v, 1e-4);
+    EXPECT_LE(dx, tol_x) << "float rounding on this trajectory: " << rounding_x << " m";
+    EXPECT_LE(dv, tol_v) << "float rounding on this trajectory: " << rounding_v << " m/s";
+    EXPECT_LE(std::abs(g_disp - a_disp), 2 * tol_x);
+    EXPECT_EQ(g.t, a.t);
+    EXPECT_LE(max_diff(g.x_prev, a.x_prev), tol_x);
+    std::printf("%s: |x - x_cpu| = %.3g m (tolerance %.3g), |v - v_cpu| = %.3g m/s (tolerance %.3g)\n",
+                case_name({c, 0}).c_str(), dx, tol_x, dv, tol_v);
+  }
+  if (e.traits.deterministic && !scatter) {
+    auto again = e.make(setup);
+    EXPECT_TRUE(bitwise_equal(advance(*again, s0, kSteps), g)) << "a second run differs";
+  }
+}
+
+// The registry's pipelines x the integrators each runs x the shapes, with default options;
+// each non-default option value on two integrators (one and several force passes) and two shapes.
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  for (const PipelineEntry& e : pipelines().all()) {
+    if (e.name == "cpu" || e.name == "reference") continue;
+    for (const IntegratorInfo& i : integrators()) {
+      if (!e.unsupported(i.id).empty()) continue;
+      for (int s = 0; s < int(std::size(kShapes)); ++s) out.push_back({e.name, i.id, s});
+    }
+    for (const auto& [option, values] : kOptionValues) {
+      if (std::find(e.options.begin(), e.options.end(), option) == e.options.end()) continue;
+      for (const std::string& v : values)
+        for (Integrator i : {Integrator::semi_implicit_euler, Integrator::rk4})
+          for (int s : {0, 3}) out.push_back({e.name, i, s, {{option, v}}});
+    }
+  }
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Pipelines, MatchCpu, testing::ValuesIn(cases()), case_name);
+
+}  // namespace
+}  // namespace deformlab::test
