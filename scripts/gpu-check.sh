@@ -22,11 +22,14 @@ summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail 
 grep -E "Label|^ *(unit|match|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
 
 cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
+match_tests="$build/tests/match/deformlab_match_tests"
 if [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
-    compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='*37x53*:*lattice7x5x6*:CudaConstraints*' \
-      >"$out/sanitizer-$tool.log" 2>&1
-    summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tail -1)")
+    {
+      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*'
+      compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*'
+    } >"$out/sanitizer-$tool.log" 2>&1
+    summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
   done
 fi
 
@@ -38,6 +41,7 @@ bench_pair() {  # name, then the bench arguments: this build's and (BASE_BENCH) 
 }
 bench_pair cuda cuda --sizes 256 1024 2048 4096
 bench_pair gl gl --sizes 256 1024 2048
+bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
 
 app="$build/app/deformlab"
 "$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
