@@ -12,14 +12,14 @@ using cuda::Variant;
 constexpr int kSteps = 30;
 constexpr Variant kVariants[] = {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused};  // the drag path ends after 10: later steps replay a CUDA graph
 
-struct Scene {
+struct ContactScene {
   Model m;
   Params p;
   std::vector<int> pinned;
 };
 
-Scene make_scene(bool spring_drag) {
-  Scene s{small_cloth(37, 53), small_params(), {}};
+ContactScene make_contact_scene(bool spring_drag) {
+  ContactScene s{small_cloth(37, 53), small_params(), {}};
   s.m.damping = {0.02f, 0.02f, 0.01f};
   s.pinned = pin_nodes(s.m, PinSet::top_corners, {});
   s.p.ground = 0.995f;  // just under the cloth: gravity and the perturbation push nodes below
@@ -31,7 +31,7 @@ Scene make_scene(bool spring_drag) {
   return s;
 }
 
-void expect_constraints_hold(const Scene& sc, const State& s0, const State& g, const std::string& what) {
+void expect_constraints_hold(const ContactScene& sc, const State& s0, const State& g, const std::string& what) {
   for (int i : sc.pinned) {
     EXPECT_TRUE(g.x[i] == s0.x[i]) << what << ": pinned node " << i << " moved";
     EXPECT_TRUE(g.v[i] == Vec3f{}) << what << ": pinned node " << i << " has a velocity";
@@ -50,7 +50,7 @@ void expect_constraints_hold(const Scene& sc, const State& s0, const State& g, c
 TEST(CudaConstraints, PinsGroundSpheresAndDragHold) {
   DEFORMLAB_REQUIRE_CUDA();
   for (bool spring_drag : {false, true}) {
-    const Scene sc = make_scene(spring_drag);
+    const ContactScene sc = make_contact_scene(spring_drag);
     const State s0 = perturbed_state(sc.m, 21u);
     for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
                              Integrator::rk4, Integrator::verlet}) {

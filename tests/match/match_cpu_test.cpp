@@ -1,6 +1,6 @@
 // Every pipeline in the registry against the CPU float pipeline (`cpu`), for every
 // integrator it runs, on every model shape below: 50 steps from a perturbed, moving state
-// with wind, spring damping and a drag spring. Pipelines that a build or machine lacks skip
+// with wind, spring damping and a drag spring (on one shape: ground, spheres and a hard drag). Pipelines that a build or machine lacks skip
 // with the reason; `reference` (double) is the yardstick, not a subject.
 //
 // What each pipeline promises is its registry trait (core/pipeline.hpp, PipelineTraits):
@@ -34,12 +34,13 @@ struct Shape {
   int nx, ny, nz;  // nz > 0: lattice
   bool damped;
   bool general = false;  // the same springs without the grid: the adjacency paths
+  bool contact = false;  // ground and spheres cutting the cloth, the drag node held on its path
 };
 const Shape kShapes[] = {
     {"cloth32", 32, 32, 0, true},       {"cloth37x53", 37, 53, 0, false},  // not a multiple of any tile
     {"cloth2x3", 2, 3, 0, true},        {"lattice6x5x4", 6, 5, 4, true},
     {"lattice3x4x5", 3, 4, 5, false},  // too narrow for the interior stencil anywhere
-    {"general32", 32, 32, 0, true, true},
+    {"general32", 32, 32, 0, true, true},       {"contact37x53", 37, 53, 0, true, false, true},
 };
 
 // Option values tried beyond the defaults, by option name (PipelineEntry::options).
@@ -71,6 +72,16 @@ Model make_model(const Shape& s) {
   return m;
 }
 
+Params make_params(const Shape& s, const Model& m, Integrator i) {
+  Params p = moving_params(m, i);
+  if (s.contact) {
+    p.ground = 0.995f;  // just under the cloth: gravity and the perturbation push nodes below
+    p.spheres = {{{0.f, 0.9f, 0.f}, 0.12f}, {{0.5f, 0.97f, 0.3f}, 0.06f}};  // both cut the cloth from below
+    p.drag.as_spring = false;
+  }
+  return p;
+}
+
 constexpr int kSteps = 50;
 
 class MatchCpu : public testing::TestWithParam<Case> {};
@@ -80,7 +91,7 @@ TEST_P(MatchCpu, FiftyStepsFromAMovingState) {
   const PipelineEntry& e = *pipelines().find(c.pipeline);
   if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
   const Model m = make_model(kShapes[c.shape]);
-  const Params p = moving_params(m, c.integrator);
+  const Params p = make_params(kShapes[c.shape], m, c.integrator);
   const State s0 = perturbed_state(m, 7u + unsigned(c.shape));
   const PipelineSetup setup{m, p, c.integrator, c.options};
 
