@@ -3,7 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
+# Environment: PARTS (which of "tests sanitizers bench experiments" to run, default all),
+# BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison).
@@ -16,14 +17,18 @@ out=${1:-gpu-check}
 max=${MAX_SIZE:-4096}
 mkdir -p "$out/results"
 summary=()
+parts=${PARTS:-tests sanitizers bench experiments}
+part() { [[ " $parts " == *" $1 "* ]]; }
 
-ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
-summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
-grep -E "Label|^ *(unit|match|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
+if part tests; then
+  ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
+  summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
+  grep -E "Label|^ *(unit|match|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
+fi
 
 cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
 match_tests="$build/tests/match/deformlab_match_tests"
-if [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
+if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
     {
       compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*'
@@ -39,15 +44,19 @@ bench_pair() {  # name, then the bench arguments: this build's and (BASE_BENCH) 
   "$bench" "$@" --csv "$out/bench-$name.csv" >"$out/bench-$name.txt" 2>&1
   if [ -n "${BASE_BENCH:-}" ]; then "$BASE_BENCH" "$@" --csv "$out/bench-$name-base.csv" >"$out/bench-$name-base.txt" 2>&1; fi
 }
-bench_pair cuda cuda --sizes 256 1024 2048 4096
-bench_pair gl gl --sizes 256 1024 2048
-bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
+if part bench; then
+  bench_pair cuda cuda --sizes 256 1024 2048 4096
+  bench_pair gl gl --sizes 256 1024 2048
+  bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
+fi
 
 app="$build/app/deformlab"
-"$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
-for x in ${EXPERIMENTS:-table2 table3 tiles interop swap}; do
-  "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
-  summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
-done
+if part experiments; then
+  "$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
+  for x in ${EXPERIMENTS-table2 table3 tiles interop swap}; do
+    "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
+    summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
+  done
+fi
 
 printf '%s\n' "${summary[@]}"
