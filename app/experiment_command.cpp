@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "experiments/ceilings.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/output.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
 
@@ -30,6 +31,7 @@ int experiment_command(const ExperimentArgs& a) {
   const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
   nlohmann::json calibration;
   try {
+    require_folder_or_nothing(dir);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << e.what() << "\n";

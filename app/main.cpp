@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
       ->required();
   experiment->add_option("--out,-o", ex.out, "Results folder (default: runs/<experiment name>)");
   experiment->add_option("--max-size", ex.max_size, "Leave out grid sizes above this for now (cells resume later)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1 << 20));
   experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
   experiment->add_option("--calibration", ex.calibration,
                          "Calibration JSON (from `deformlab calibrate --out`) to record in the manifest and show "

@@ -1,10 +1,11 @@
 #include "scene.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
+
+#include "json_file.hpp"
 
 namespace deformlab {
 
@@ -27,17 +28,23 @@ void only_keys(const json& j, const std::string& where, std::initializer_list<co
     }
 }
 
-float num(const json& j, const std::string& where) {
+// What a number may be: any finite value, > 0 or >= 0.
+enum class Range { any, positive, non_negative };
+
+float num(const json& j, const std::string& where, Range r = Range::any) {
   if (!j.is_number()) bad(where, "expected a number");
   const double d = j.get<double>();
-  if (!std::isfinite(d)) bad(where, "expected a finite number");
+  if (!std::isfinite(d) || std::abs(d) > 3.0e38) bad(where, "expected a finite number");
+  if (r == Range::positive && !(d > 0)) bad(where, "expected a number > 0");
+  if (r == Range::non_negative && !(d >= 0)) bad(where, "expected a number >= 0");
   return float(d);
 }
 
-int integer(const json& j, const std::string& where) {
+int integer(const json& j, const std::string& where, std::int64_t min = INT32_MIN) {
   if (!j.is_number_integer()) bad(where, "expected an integer");
   const auto v = j.get<std::int64_t>();
-  if (v < INT32_MIN || v > INT32_MAX) bad(where, "integer out of range");
+  if (v < min) bad(where, "expected an integer >= " + std::to_string(min));
+  if (v > INT32_MAX) bad(where, "integer out of range");
   return int(v);
 }
 
@@ -46,15 +53,15 @@ Vec3f vec3(const json& j, const std::string& where) {
   return {num(j[0], where + "[0]"), num(j[1], where + "[1]"), num(j[2], where + "[2]")};
 }
 
-void per_kind(std::array<float, kSpringKinds>& out, const json& j, const std::string& where) {
+void per_kind(std::array<float, kSpringKinds>& out, const json& j, const std::string& where, Range r) {
   if (j.is_number()) {
-    out.fill(num(j, where));
+    out.fill(num(j, where, r));
     return;
   }
   only_keys(j, where, {"structural", "shear", "flexion"});
   for (int k = 0; k < kSpringKinds; ++k) {
     const char* name = to_string(SpringKind(k));
-    if (j.contains(name)) out[k] = num(j[name], where + "." + name);
+    if (j.contains(name)) out[k] = num(j[name], where + "." + name, r);
   }
 }
 
@@ -71,22 +78,28 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where) {
     const std::size_t want = m.topology == Topology::lattice ? 3 : 2;
     if (!s.is_array() || s.size() != want)
       bad(where + ".size", want == 3 ? "expected [nx, ny, nz]" : "expected [nx, ny]");
-    m.nx = integer(s[0], where + ".size[0]");
-    m.ny = integer(s[1], where + ".size[1]");
-    m.nz = want == 3 ? integer(s[2], where + ".size[2]") : 1;
+    m.nx = integer(s[0], where + ".size[0]", 1);
+    m.ny = integer(s[1], where + ".size[1]", 1);
+    m.nz = want == 3 ? integer(s[2], where + ".size[2]", 1) : 1;
   }
-  if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing");
-  if (j.contains("width")) m.width = num(j["width"], where + ".width");
+  if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);  // 0: from width
+  if (j.contains("width")) m.width = num(j["width"], where + ".width", Range::positive);
   if (j.contains("height")) m.height = num(j["height"], where + ".height");
-  if (j.contains("node_mass")) m.material.node_mass = num(j["node_mass"], where + ".node_mass");
-  if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness");
-  if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping");
+  if (j.contains("node_mass")) m.material.node_mass = num(j["node_mass"], where + ".node_mass", Range::positive);
+  if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness", Range::positive);
+  if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
     const auto& p = j["pins"];
     if (p.is_array()) {
       m.pins = PinSet::list;
       m.pin_list.clear();
-      for (std::size_t k = 0; k < p.size(); ++k) m.pin_list.push_back(integer(p[k], where + ".pins[" + std::to_string(k) + "]"));
+      std::set<int> seen;
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        const std::string w = where + ".pins[" + std::to_string(k) + "]";
+        const int node = integer(p[k], w, 0);
+        if (!seen.insert(node).second) bad(w, "node " + std::to_string(node) + " is listed twice");
+        m.pin_list.push_back(node);
+      }
     } else {
       const auto s = p.is_string() ? p.get<std::string>() : "";
       if (s == "none") m.pins = PinSet::none;
@@ -104,14 +117,14 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
   d.enabled = true;
   if (j.contains("node")) {
     if (j["node"] == "center") { d.center = true; d.node = -1; }
-    else { d.center = false; d.node = integer(j["node"], where + ".node"); if (d.node < 0) bad(where + ".node", "must be >= 0"); }
+    else { d.center = false; d.node = integer(j["node"], where + ".node", 0); }
   }
   if (j.contains("mode")) {
     if (j["mode"] == "hard") h.as_spring = false;
     else if (j["mode"] == "spring") h.as_spring = true;
     else bad(where + ".mode", "expected \"hard\" or \"spring\"");
   }
-  if (j.contains("stiffness")) h.stiffness = num(j["stiffness"], where + ".stiffness");
+  if (j.contains("stiffness")) h.stiffness = num(j["stiffness"], where + ".stiffness", Range::positive);
   if (j.contains("path_is")) {
     if (j["path_is"] == "offset") d.offsets = true;
     else if (j["path_is"] == "position") d.offsets = false;
@@ -125,6 +138,7 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
       const std::string w = where + ".path[" + std::to_string(k) + "]";
       if (!p[k].is_array() || p[k].size() != 4) bad(w, "expected [t, x, y, z]");
       h.path.push_back({num(p[k][0], w + "[0]"), {num(p[k][1], w + "[1]"), num(p[k][2], w + "[2]"), num(p[k][3], w + "[3]")}});
+      if (k > 0 && !(h.path[k].t > h.path[k - 1].t)) bad(w + "[0]", "keyframe times must increase");
     }
   }
 }
@@ -136,9 +150,9 @@ void apply_json(Scene& s, const json& j, const std::string& where) {
                        "min_steps", "max_steps", "check_every", "runaway_factor"});
   Params& p = s.params;
   if (j.contains("model")) apply_model(s.model, j["model"], where + ".model");
-  if (j.contains("dt")) p.dt = num(j["dt"], where + ".dt");
+  if (j.contains("dt")) p.dt = num(j["dt"], where + ".dt", Range::positive);
   if (j.contains("gravity")) p.gravity = vec3(j["gravity"], where + ".gravity");
-  if (j.contains("damping")) p.damping = num(j["damping"], where + ".damping");
+  if (j.contains("damping")) p.damping = num(j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("wind")) p.wind = vec3(j["wind"], where + ".wind");
   if (j.contains("ground")) {
     if (j["ground"].is_null()) p.ground.reset();
@@ -152,31 +166,27 @@ void apply_json(Scene& s, const json& j, const std::string& where) {
       const std::string w = where + ".spheres[" + std::to_string(k) + "]";
       only_keys(a[k], w, {"center", "radius"});
       if (!a[k].contains("center") || !a[k].contains("radius")) bad(w, "needs center and radius");
-      p.spheres.push_back({vec3(a[k]["center"], w + ".center"), num(a[k]["radius"], w + ".radius")});
+      p.spheres.push_back({vec3(a[k]["center"], w + ".center"), num(a[k]["radius"], w + ".radius", Range::positive)});
     }
   }
   if (j.contains("drag")) {
     if (j["drag"].is_null()) { s.drag = {}; p.drag = {}; }
     else apply_drag(s, j["drag"], where + ".drag");
   }
-  if (j.contains("threshold")) p.threshold = num(j["threshold"], where + ".threshold");
-  if (j.contains("min_steps")) p.min_steps = integer(j["min_steps"], where + ".min_steps");
-  if (j.contains("max_steps")) p.max_steps = integer(j["max_steps"], where + ".max_steps");
-  if (j.contains("check_every")) p.check_every = integer(j["check_every"], where + ".check_every");
-  if (j.contains("runaway_factor")) p.runaway_factor = num(j["runaway_factor"], where + ".runaway_factor");
+  if (j.contains("threshold")) p.threshold = num(j["threshold"], where + ".threshold", Range::positive);
+  if (j.contains("min_steps")) p.min_steps = integer(j["min_steps"], where + ".min_steps", 0);
+  if (j.contains("max_steps")) p.max_steps = integer(j["max_steps"], where + ".max_steps", 1);
+  if ((j.contains("min_steps") || j.contains("max_steps")) && p.min_steps > p.max_steps)
+    bad(where + (j.contains("min_steps") ? ".min_steps" : ".max_steps"),
+        "min_steps (" + std::to_string(p.min_steps) + ") exceeds max_steps (" + std::to_string(p.max_steps) + ")");
+  if (j.contains("check_every")) p.check_every = integer(j["check_every"], where + ".check_every", 1);
+  if (j.contains("runaway_factor"))
+    p.runaway_factor = num(j["runaway_factor"], where + ".runaway_factor", Range::positive);
 }
 
 Scene load_scene(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot open scene file '" + path + "'");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw std::invalid_argument("scene file '" + path + "' is not valid JSON: " + e.what());
-  }
   Scene s;
-  apply_json(s, j, path);
+  apply_json(s, read_json_file(path, "scene file"), path);
   return s;
 }
 

@@ -1,8 +1,8 @@
 #include "ceilings.hpp"
 
-#include <fstream>
 #include <stdexcept>
 
+#include "core/json_file.hpp"
 #include "core/profiler.hpp"
 
 namespace deformlab {
@@ -52,10 +52,8 @@ Ceilings ceilings_of(const json& cal) {
 }
 
 json read_calibration(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument("cannot read the calibration file " + file.string());
-  const json j = json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object())
+  const json j = read_json_file(file.string(), "calibration file");
+  if (!j.is_object())
     throw std::invalid_argument(file.string() + ": not a JSON object (expected `deformlab calibrate --out`'s file)");
   if (!ceilings_of(j).any())
     throw std::invalid_argument(file.string() +

@@ -1,9 +1,9 @@
 #include "experiment.hpp"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
+
+#include "core/json_file.hpp"
 
 #include "experiment_files.hpp"
 
@@ -11,13 +11,9 @@ namespace deformlab {
 
 using nlohmann::json;
 
-Experiment parse_experiment(const std::string& text, const std::string& where) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw std::invalid_argument("experiment file '" + where + "' is not valid JSON: " + e.what());
-  }
+namespace {
+
+Experiment from_json(const json& j, const std::string& where) {
   if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
   Experiment x;
   // "base": start from another built-in experiment's scene and settings.
@@ -52,13 +48,13 @@ Experiment parse_experiment(const std::string& text, const std::string& where) {
   return x;
 }
 
-Experiment load_experiment(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot open experiment file '" + path + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_experiment(ss.str(), path);
+}  // namespace
+
+Experiment parse_experiment(const std::string& text, const std::string& where) {
+  return from_json(parse_json(text, "experiment file '" + where + "'"), where);
 }
+
+Experiment load_experiment(const std::string& path) { return from_json(read_json_file(path, "experiment file"), path); }
 
 Experiment load_experiment_by_name(const std::string& path_or_name) {
   if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos)

@@ -15,10 +15,15 @@ namespace deformlab {
 
 namespace fs = std::filesystem;
 
+void require_folder_or_nothing(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
+}
+
 OutputDir::OutputDir(const fs::path& dir) : dir_(dir) {
   std::error_code ec;
-  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
-    throw std::invalid_argument("output path '" + dir_.string() + "' exists and is not a folder");
+  require_folder_or_nothing(dir_);
   created_ = !fs::exists(dir_, ec);
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());

@@ -12,6 +12,9 @@
 
 namespace deformlab {
 
+// Throws std::invalid_argument when `dir` exists and is not a folder.
+void require_folder_or_nothing(const std::filesystem::path& dir);
+
 class OutputDir {
  public:
   // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder).

@@ -1,0 +1,151 @@
+// Every kind of bad input, one row each: flags, scene files (malformed, out of range, not a
+// file), experiment and calibration files. Each must exit 2 with one line naming the flag or
+// the file and key path, write nothing and leave an existing output folder as it was.
+// In the arguments, {dir} is the test's folder; the files of a row are written there first.
+#include <set>
+#include <vector>
+
+#include "cli_support.hpp"
+
+namespace deformlab::test {
+namespace {
+
+struct BadInput {
+  const char* name;
+  std::string args;
+  std::string needle;
+  std::vector<std::pair<std::string, std::string>> files = {};
+};
+
+// A scene file s.json holding `json`, run on cpu: its error names the key path `key`.
+BadInput scene(const char* name, const std::string& json, const std::string& key) {
+  return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", json}}};
+}
+
+const std::vector<BadInput>& cases() {
+  static const std::vector<BadInput> all = {
+      // flags
+      {"unknown_pipeline", "run --pipeline warp", "unknown pipeline 'warp' (valid: best, "},
+      {"unknown_integrator", "run --integrator leapfrog", "unknown integrator 'leapfrog' (valid: explicit-euler, "},
+      {"grid_zero", "run --grid 0x5", "--grid '0x5'"},
+      {"grid_negative", "run --grid -3x4", "--grid"},
+      {"grid_letters", "run --grid abcx4", "--grid 'abcx4'"},
+      {"grid_one_number", "run --grid 5", "expected WxH"},
+      {"grid_trailing_x", "run --grid 5x", "expected WxH"},
+      {"lattice_two_numbers", "run --lattice 2x2", "expected WxHxD"},
+      {"lattice_zero", "run --lattice 0x2x2", "--lattice"},
+      {"dt_zero", "run --dt 0", "--dt must be a positive"},
+      {"dt_negative", "run --dt -1", "--dt"},
+      {"dt_nan", "run --dt nan", "--dt"},
+      {"dt_inf", "run --dt inf", "--dt"},
+      {"dt_letters", "run --dt abc", "--dt"},
+      {"steps_zero", "run --steps 0", "--steps"},
+      {"steps_negative", "run --steps -5", "--steps"},
+      {"steps_letters", "run --steps abc", "--steps"},
+      {"threshold_zero", "run --pipeline cpu --threshold 0", "threshold"},
+      {"check_every_zero", "run --pipeline cpu --check-every 0", "check_every"},
+      {"compare_unknown", "run --compare gpu", "--compare"},
+      {"option_not_read", "run --pipeline cpu --option tile=8x8", "--option 'tile' is not an option of cpu"},
+      {"option_no_value", "run --option tile", "expected NAME=VALUE"},
+      {"unknown_flag", "run --colour red", "--colour"},
+      {"grid_too_large", "run --grid 100000x100000", "GiB of memory"},
+      {"lattice_too_large", "run --lattice 2000x2000x2000", "GiB of memory"},
+      {"out_is_a_file", "run --pipeline cpu --steps 3 --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
+      // scene files that are no JSON file
+      {"scene_missing", "run --scene {dir}/missing.json", "cannot open scene file"},
+      {"scene_directory", "run --scene {dir}", "is a directory, not a JSON file"},
+      {"scene_device", "run --scene /dev/zero", "scene file '/dev/zero' is not a regular file"},
+      {"scene_empty", "run --scene {dir}/s.json", "is not valid JSON: parse error", {{"s.json", ""}}},
+      {"scene_binary", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", std::string("\x01\xff\x00\x7f", 4)}}},
+      {"scene_truncated", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", "{\"dt\": "}}},
+      {"scene_overflow", "run --scene {dir}/s.json", "is not valid JSON: number overflow parsing '1e999'",
+       {{"s.json", "{\"dt\": 1e999}"}}},
+      // scene values
+      scene("unknown_key", "{\"dtt\": 1}", "s.json.dtt: unknown key"),
+      scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
+      scene("dt_negative_in_file", "{\"dt\": -0.001}", "s.json.dt: expected a number > 0"),
+      scene("dt_string", "{\"dt\": \"fast\"}", "s.json.dt: expected a number"),
+      scene("gravity_two", "{\"gravity\": [0, 1]}", "s.json.gravity: expected [x, y, z]"),
+      scene("wind_string", "{\"wind\": [0, \"a\", 0]}", "s.json.wind[1]: expected a number"),
+      scene("damping_negative", "{\"damping\": -1}", "s.json.damping: expected a number >= 0"),
+      scene("ground_string", "{\"ground\": \"low\"}", "s.json.ground: expected a number"),
+      scene("model_type", "{\"model\": {\"type\": \"sphere\"}}", "s.json.model.type"),
+      scene("size_zero", "{\"model\": {\"size\": [0, 4]}}", "s.json.model.size[0]: expected an integer >= 1"),
+      scene("size_one_number", "{\"model\": {\"size\": [4]}}", "s.json.model.size: expected [nx, ny]"),
+      scene("size_fraction", "{\"model\": {\"size\": [4.5, 4]}}", "s.json.model.size[0]: expected an integer"),
+      scene("size_huge", "{\"model\": {\"size\": [4, 9999999999]}}", "s.json.model.size[1]: integer out of range"),
+      scene("stiffness_negative", "{\"model\": {\"stiffness\": {\"structural\": -200}}}",
+            "s.json.model.stiffness.structural: expected a number > 0"),
+      scene("stiffness_zero", "{\"model\": {\"stiffness\": 0}}", "s.json.model.stiffness: expected a number > 0"),
+      scene("stiffness_string", "{\"model\": {\"stiffness\": {\"shear\": \"x\"}}}",
+            "s.json.model.stiffness.shear: expected a number"),
+      scene("stiffness_kind", "{\"model\": {\"stiffness\": {\"bend\": 1}}}", "s.json.model.stiffness.bend: unknown key"),
+      scene("spring_damping_negative", "{\"model\": {\"damping\": -5}}", "s.json.model.damping: expected a number >= 0"),
+      scene("flexion_damping_negative", "{\"model\": {\"damping\": {\"flexion\": -1}}}",
+            "s.json.model.damping.flexion: expected a number >= 0"),
+      scene("mass_zero", "{\"model\": {\"node_mass\": 0}}", "s.json.model.node_mass: expected a number > 0"),
+      scene("mass_negative", "{\"model\": {\"node_mass\": -1}}", "s.json.model.node_mass: expected a number > 0"),
+      scene("width_negative", "{\"model\": {\"width\": -1}}", "s.json.model.width: expected a number > 0"),
+      scene("spacing_negative", "{\"model\": {\"spacing\": -0.1}}", "s.json.model.spacing: expected a number >= 0"),
+      scene("pins_duplicate", "{\"model\": {\"pins\": [0, 0]}}", "s.json.model.pins[1]: node 0 is listed twice"),
+      scene("pins_negative", "{\"model\": {\"pins\": [-1]}}", "s.json.model.pins[0]: expected an integer >= 0"),
+      scene("pins_outside", "{\"model\": {\"size\": [8, 8], \"pins\": [99999]}}", "pinned node 99999 is outside the model"),
+      scene("pins_name", "{\"model\": {\"pins\": \"bottom\"}}", "s.json.model.pins: expected \"none\""),
+      scene("sphere_no_radius", "{\"spheres\": [{\"center\": [0, 0, 0]}]}", "s.json.spheres[0]: needs center and radius"),
+      scene("sphere_radius_zero", "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 0}]}",
+            "s.json.spheres[0].radius: expected a number > 0"),
+      scene("spheres_not_list", "{\"spheres\": 5}", "s.json.spheres: expected a list"),
+      scene("drag_node_negative", "{\"drag\": {\"node\": -1, \"path\": [[0, 0, 0, 0]]}}",
+            "s.json.drag.node: expected an integer >= 0"),
+      scene("drag_node_outside", "{\"model\": {\"size\": [4, 4]}, \"drag\": {\"node\": 99, \"path\": [[0, 0, 0, 0]]}}",
+            "drag node 99 is outside the model"),
+      scene("drag_mode", "{\"drag\": {\"mode\": \"soft\"}}", "s.json.drag.mode: expected \"hard\" or \"spring\""),
+      scene("drag_stiffness", "{\"drag\": {\"stiffness\": -5}}", "s.json.drag.stiffness: expected a number > 0"),
+      scene("drag_path_empty", "{\"drag\": {\"path\": []}}", "s.json.drag.path: expected a non-empty list"),
+      scene("drag_keyframe_short", "{\"drag\": {\"path\": [[0, 0, 0]]}}", "s.json.drag.path[0]: expected [t, x, y, z]"),
+      scene("drag_keyframes_backwards", "{\"drag\": {\"path\": [[1, 0, 0, 0], [0.5, 0, 0, 0]]}}",
+            "s.json.drag.path[1][0]: keyframe times must increase"),
+      scene("threshold_zero_in_file", "{\"threshold\": 0}", "s.json.threshold: expected a number > 0"),
+      scene("min_steps_negative", "{\"min_steps\": -1}", "s.json.min_steps: expected an integer >= 0"),
+      scene("max_steps_zero", "{\"max_steps\": 0}", "s.json.max_steps: expected an integer >= 1"),
+      scene("min_above_max", "{\"min_steps\": 500, \"max_steps\": 100}",
+            "s.json.min_steps: min_steps (500) exceeds max_steps (100)"),
+      scene("check_every_zero_in_file", "{\"check_every\": 0}", "s.json.check_every: expected an integer >= 1"),
+      scene("runaway_zero", "{\"runaway_factor\": 0}", "s.json.runaway_factor: expected a number > 0"),
+      // experiment and calibration files
+      {"experiment_key", "run --experiment {dir}/x.json", "x.json.pipline: unknown key", {{"x.json", "{\"pipline\": \"cpu\"}"}}},
+      {"experiment_scene_value", "run --experiment {dir}/x.json", "x.json.scene.dt: expected a number > 0",
+       {{"x.json", "{\"scene\": {\"dt\": -1}}"}}},
+      {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
+      {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
+      {"experiment_max_size_zero", "experiment quick --max-size 0", "--max-size: Value 0 not in range 1 to 1048576"},
+      {"experiment_out_is_a_file", "experiment quick --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
+      {"calibration_missing", "experiment quick --calibration {dir}/none.json", "cannot open calibration file"},
+      {"calibration_list", "experiment quick --calibration {dir}/c.json", "not a JSON object", {{"c.json", "[1, 2]"}}},
+      {"calibration_empty", "experiment quick --calibration {dir}/c.json", "no ceilings in it",
+       {{"c.json", "{\"copy\": {\"GB_per_s\": 0}}"}}},
+  };
+  return all;
+}
+
+class Refused : public Cli, public testing::WithParamInterface<BadInput> {};
+
+TEST_P(Refused, WithOneLineAndNothingWritten) {
+  const BadInput& c = GetParam();
+  for (const auto& [name, text] : c.files) std::ofstream(dir_ / name, std::ios::binary) << text;
+  std::string args = c.args;
+  for (std::size_t at; (at = args.find("{dir}")) != std::string::npos;) args.replace(at, 5, dir_.string());
+  expect_refused(args, c.needle);
+}
+
+TEST(BadInputTable, HasAtLeastSixtyRowsWithDistinctNames) {
+  std::set<std::string> names;
+  for (const BadInput& c : cases()) EXPECT_TRUE(names.insert(c.name).second) << c.name;
+  EXPECT_GE(cases().size(), 60u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, Refused, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<BadInput>& p) { return std::string(p.param.name); });
+
+}  // namespace
+}  // namespace deformlab::test
