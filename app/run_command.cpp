@@ -40,6 +40,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   pipe.set_state(rest_state(in.model));
   RunOptions opt;
   opt.until_converged = in.until_converged;
+  opt.integrator = in.integ;
   opt.profiler = &profiler;
 #if DEFORMLAB_GL_RENDER
   std::optional<gl::FrameWriter> frames;
@@ -94,7 +95,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"scene", to_json(in.x.scene)},
       {"model", {{"nodes", in.model.node_count()}, {"springs", in.model.spring_count()},
                  {"drag_node", in.params.drag.node},
-                 {"explicit_stability_limit_s", explicit_stability_limit(in.model, in.params)}}},
+                 {"stability_limit_s", stability_limit(in.model, in.params, in.integ)}}},
       {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * double(in.params.dt)},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"median_step_ms_host_clock", median_ms}, {"stage_timing", pipe.timing_method()}}},

@@ -7,17 +7,45 @@
 
 namespace deformlab {
 
-double explicit_stability_limit(const Model& m, const Params& p) {
-  double limit = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < m.node_count(); ++i) {
-    if (m.inv_mass[i] == 0.f) continue;
-    double ksum = 0.0;
-    for (int e = m.adj_offset[i]; e < m.adj_offset[i + 1]; ++e) ksum += m.stiffness[int(m.kind[m.adj_spring[e]])];
-    if (p.drag.active() && p.drag.as_spring && i == p.drag.node) ksum += p.drag.stiffness;
-    if (ksum <= 0.0) continue;
-    limit = std::min(limit, 2.0 * std::sqrt((1.0 / m.inv_mass[i]) / (2.0 * ksum)));
+double stability_limit(const Model& m, const Params& p, Integrator i) {
+  double w2 = 0.0;  // Gershgorin bound on the largest squared angular frequency
+  for (int n = 0; n < m.node_count(); ++n) {
+    if (m.inv_mass[n] == 0.f) continue;
+    double k = 0.0;
+    for (int e = m.adj_offset[n]; e < m.adj_offset[n + 1]; ++e) k += 2.0 * m.spring_k(m.adj_spring[e]);
+    if (p.drag.active() && p.drag.as_spring && n == p.drag.node) k += p.drag.stiffness;
+    w2 = std::max(w2, k * m.inv_mass[n]);
   }
-  return limit;
+  const double w = std::sqrt(w2);
+  switch (i) {
+    case Integrator::semi_implicit_euler:
+    case Integrator::verlet: return 2.0 / w;
+    case Integrator::rk3: return std::sqrt(3.0) / w;
+    case Integrator::rk4: return 2.0 * std::sqrt(2.0) / w;
+    case Integrator::explicit_euler:
+    case Integrator::midpoint: return w > 0 ? 0.0 : std::numeric_limits<double>::infinity();
+    case Integrator::backward_euler: break;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+std::string stability_hint(const Model& m, const Params& p, Integrator i) {
+  const double limit = stability_limit(m, p, i);
+  const std::string name(info(i).name);
+  std::ostringstream os;
+  if (limit == 0.0) {
+    os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable for dt < "
+       << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
+  } else if (std::isinf(limit)) {
+    os << name << " is stable at any dt on the linearised springs: stretching or contact made it diverge";
+  } else if (p.dt >= limit) {
+    os << "dt = " << p.dt << " s is above " << name << "'s stability bound dt < " << limit
+       << " s on this model's linearised springs";
+  } else {
+    os << "dt = " << p.dt << " s is below " << name << "'s stability bound " << limit
+       << " s on the linearised springs: stretching, contact or a stiff drag made it diverge";
+  }
+  return os.str();
 }
 
 RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions& opt) {
@@ -52,8 +80,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
         else
           os << "a node moved " << disp << " m in one step, more than " << runaway
              << " m (runaway_factor x model extent)";
-        os << "; explicit stability limit dt < 2 sqrt(m / k_eff) = " << explicit_stability_limit(m, p)
-           << " s for this model, dt = " << p.dt << " s";
+        os << "; " << stability_hint(m, p, opt.integrator);
         throw DivergenceError(step, os.str());
       }
     }

@@ -7,16 +7,23 @@
 #include <vector>
 
 #include "model.hpp"
+#include "integrator.hpp"
 #include "params.hpp"
 #include "pipeline.hpp"
 
 namespace deformlab {
 
-// Largest explicit time step for which a symplectic scheme stays stable on this model:
-// dt < 2 sqrt(m / k_eff), with k_eff = 2 * (sum of incident spring stiffness) per node,
-// a Gershgorin bound on the stiffness matrix (so the limit is conservative). Infinite when
-// no free node has springs.
-double explicit_stability_limit(const Model& m, const Params& p);
+// The largest time step for which `i` keeps the model's springs, linearised at rest and
+// undamped, from growing: c / w_max, with c = 2 for the symplectic schemes (semi-implicit
+// Euler, Verlet), sqrt(3) for RK3 and 2 sqrt(2) for RK4 (where their stability regions
+// cross the imaginary axis), and w_max^2 bounded above by Gershgorin: the largest
+// (2 x incident stiffness + drag spring) / mass of a free node. So a step below it is stable
+// on the linearised model (the bound is exact for a single free spring); stretching, contact
+// and damping move the true limit. Infinite for backward Euler and where no free node has a
+// spring; 0 for explicit Euler and midpoint, which amplify an undamped oscillation at any step.
+double stability_limit(const Model& m, const Params& p, Integrator i);
+// What a divergence message says about the step: the bound and where dt lies against it.
+std::string stability_hint(const Model& m, const Params& p, Integrator i);
 
 class DivergenceError : public std::runtime_error {
  public:
@@ -45,6 +52,7 @@ struct RunOptions {
   std::function<void(int step)> after_step;
   // When set: the pipeline's own stage spans, plus "step" and "reductions" on the host clock.
   Profiler* profiler = nullptr;
+  Integrator integrator = Integrator::semi_implicit_euler;  // the pipeline's, for the divergence message
 };
 
 // Throws DivergenceError naming the step, what was seen and the stability limit.

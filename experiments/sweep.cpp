@@ -146,6 +146,7 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
     fs::remove_all(tmp);
     gl::FrameWriter frames(m, tmp, every, {512, 512});
     RunOptions opt;
+    opt.integrator = integ;
     opt.after_step = [&](int step) { frames.after_step(*pipe, step); };
     const RunResult r = run(*pipe, m, p, opt);
     frames.finish(*pipe, r.steps);
