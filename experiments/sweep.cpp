@@ -106,6 +106,14 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     if (!pipelines().find(p)) bad(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
   for (const auto& i : s.integrators)
     if (!parse_integrator(i)) bad(w + ".integrators", "unknown integrator '" + i + "' (valid: " + integrator_names() + ")");
+  for (const auto& o : s.option_sets)
+    for (const auto& [name, value] : o) {
+      const bool read = std::any_of(s.pipelines.begin(), s.pipelines.end(), [&, &name = name](const std::string& p) {
+        const auto& names = pipelines().find(p)->options;
+        return std::find(names.begin(), names.end(), name) != names.end();
+      });
+      if (!read) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
+    }
   return s;
 }
 

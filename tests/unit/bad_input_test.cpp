@@ -116,6 +116,8 @@ const std::vector<BadInput>& cases() {
       {"experiment_key", "run --experiment {dir}/x.json", "x.json.pipline: unknown key", {{"x.json", "{\"pipline\": \"cpu\"}"}}},
       {"experiment_scene_value", "run --experiment {dir}/x.json", "x.json.scene.dt: expected a number > 0",
        {{"x.json", "{\"scene\": {\"dt\": -1}}"}}},
+      {"sweep_option_unread", "experiment {dir}/x.json", "x.json.sweep.options.tyle: no pipeline of this sweep reads option 'tyle'",
+       {{"x.json", "{\"sweep\": {\"sizes\": [8], \"pipelines\": [\"cpu\"], \"options\": [{\"tyle\": \"8x8\"}]}}"}}},
       {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_max_size_zero", "experiment quick --max-size 0", "--max-size: Value 0 not in range 1 to 1048576"},

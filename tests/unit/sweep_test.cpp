@@ -107,11 +107,14 @@ TEST_F(SweepTest, SlowCellsAreCutWithTheReason) {
 }
 
 TEST_F(SweepTest, OptionSetsGoToThePipelinesThatReadThem) {
-  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu", "omp"],
+  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu", "cuda-tiled"],
                                 "options": [{"tile": "8x8"}, {"tile": "16x16"}]})");
   const auto cs = cells(*parse_sweep(x.raw, "tiny"));
-  ASSERT_EQ(cs.size(), 2u);  // neither reads "tile": each runs once, without options
-  EXPECT_TRUE(cs[0].options.empty() && cs[1].options.empty());
+  ASSERT_EQ(cs.size(), 3u);  // cpu reads no "tile": it runs once, without options
+  EXPECT_EQ(cs[0].pipeline, "cpu");
+  EXPECT_TRUE(cs[0].options.empty());
+  EXPECT_EQ(cs[1].options.at("tile"), "8x8");
+  EXPECT_EQ(cs[2].options.at("tile"), "16x16");
 }
 
 TEST_F(SweepTest, BadSweepsAreNamed) {
@@ -129,6 +132,9 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
             std::string::npos);
   EXPECT_NE(error(R"({"sizes": [0], "pipelines": ["cpu"]})").find("sweep.sizes"), std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "reps": 3})").find("sweep.reps: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "omp"], "options": [{"tile": "8x8"}]})")
+                .find("sweep.options.tile: no pipeline of this sweep reads option 'tile'"),
             std::string::npos);
 }
 
