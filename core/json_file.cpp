@@ -37,7 +37,6 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
   if (!in) throw std::invalid_argument("cannot open " + name);
   std::ostringstream text;
   text << in.rdbuf();
-  if (!in.good() && !in.eof()) throw std::invalid_argument("cannot read " + name);
   return parse_json(text.str(), name);
 }
 

@@ -116,7 +116,6 @@ void GlPipeline::plan() {
       throw std::logic_error("schedule shape not supported on the GL pipelines");
     GpuPass g{};
     g.stage = f.src;
-    g.time_fraction = f.time_fraction;
     g.kind = s.single_pass() ? PassKind::one : next.dst == Pass::kResult ? PassKind::result : PassKind::stage;
     g.weights = {float(s.weight()), 0.f, 0.f, 0.f};
     if (next.op == Pass::Op::combine)

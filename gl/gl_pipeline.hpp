@@ -95,7 +95,6 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   struct GpuPass {
     PassKind kind;
     int stage;
-    double time_fraction;
     std::array<float, kMaxStages> weights;  // of the slopes 0..stage (one: b_0)
     Program prog;
     GLint drag_force_target, drag_next, has_prev;
