@@ -20,6 +20,7 @@ struct RunArgs {
   std::optional<int> frames;     // render a frame every N steps into DIR/frames (GL builds)
   std::optional<int> gl_device;  // EGL device index for the GL context (GL builds)
   bool trace = false;            // also write trace.json (Chrome trace of the spans)
+  bool no_state = false;         // leave out state.ply
 };
 
 struct CalibrateArgs {

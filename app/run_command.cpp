@@ -1,3 +1,5 @@
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
@@ -82,6 +84,18 @@ json stages_of(const Profiler& profiler) {
   return stages;
 }
 
+// What the run's memory check counted and the process's measured peak.
+json memory_of(const RunInput& in) {
+  const Footprint f = in.entry->footprint(in.model.size(), in.integ, in.options);
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return {{"model_host_bytes", in.model.host_bytes()},
+          {"pipeline_host_bytes", f.host},
+          {"pipeline_device_bytes", f.device},
+          {"state_host_bytes", state_host_bytes(in.model.node_count())},
+          {"peak_resident_bytes", std::int64_t(u.ru_maxrss) * 1024}};
+}
+
 json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, const Ran& ran, const Profiler& profiler,
                  double median_ms) {
   const RunResult& r = ran.result;
@@ -95,7 +109,9 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"scene", to_json(in.x.scene)},
       {"model", {{"nodes", in.model.node_count()}, {"springs", in.model.spring_count()},
                  {"drag_node", in.params.drag.node},
-                 {"stability_limit_s", stability_limit(in.model, in.params, in.integ)}}},
+                 {"stability_limit_s", stability_limit(in.model, in.params, in.integ)},
+                 {"host_bytes", in.model.host_bytes()}}},
+      {"memory", memory_of(in)},
       {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * double(in.params.dt)},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"median_step_ms_host_clock", median_ms}, {"stage_timing", pipe.timing_method()}}},
@@ -106,6 +122,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"build", build_info()},
       {"machine", machine_info()}};
   if (a.trace) manifest["files"]["trace.json"] = "Chrome trace of the spans (open in Perfetto: ui.perfetto.dev)";
+  if (a.no_state) manifest["files"].erase("state.ply");
   if (!ran.frames.is_null()) manifest["frames"] = ran.frames;
   return manifest;
 }
@@ -135,8 +152,16 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   for (const auto& g : profiler.summary())
     std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
               << " ms  (" << g.clock << ")\n";
-  std::cout << "  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, state.ply, manifest.json"
-            << (a.trace ? ", trace.json" : "") << "}\n";
+  const json mem = memory_of(in);
+  const double nodes = double(m.node_count());
+  std::cout << "  memory: host " << gib(mem["peak_resident_bytes"]) << " at peak ("
+            << mem["peak_resident_bytes"].get<double>() / nodes << " bytes/node; the model "
+            << mem["model_host_bytes"].get<double>() / nodes << ")";
+  if (mem["pipeline_device_bytes"].get<std::int64_t>() > 0)
+    std::cout << ", device " << gib(mem["pipeline_device_bytes"]) << " ("
+              << mem["pipeline_device_bytes"].get<double>() / nodes << " bytes/node)";
+  std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
+            << "manifest.json" << (a.trace ? ", trace.json" : "") << "}\n";
 }
 
 }  // namespace
@@ -160,7 +185,7 @@ int run_command(const RunArgs& a) {
     write_timings_csv(dir.staged("timings.csv"), r);
     profiler.write_csv(dir.staged("spans.csv").string());
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
-    write_ply(dir.staged("state.ply"), in.model, final_state);
+    if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
     json manifest = manifest_of(a, in, *pipe, ran, profiler, med);
     if (a.compare) manifest["compare"] = compare;
 #if DEFORMLAB_GL_RENDER

@@ -99,18 +99,11 @@ void apply_param_flags(const RunArgs& a, Params& p) {
   if (a.steps && *a.steps < 1) throw BadInput("--steps must be at least 1");
 }
 
-// Refuses sizes that cannot fit (`copies` models: 2 with --compare) before allocating them.
-void check_fits(const ModelSpec& ms, int copies) {
-  const auto [nodes, springs] = model_size(ms);
-  const std::int64_t need = model_bytes(nodes, springs) * copies;
-  const std::int64_t have = available_memory_bytes();
-  if (nodes <= (std::int64_t(1) << 30) && (have <= 0 || need <= have)) return;
-  std::ostringstream os;
-  os << "a model of " << nodes << " nodes and " << springs << " springs needs about "
-     << double(need) / double(1 << 30) << " GiB of memory";
-  if (have > 0) os << ", " << double(have) / double(1 << 30) << " GiB are available";
-  if (nodes > (std::int64_t(1) << 30)) os << " (and exceeds the limit of 2^30 nodes)";
-  throw BadInput(os.str());
+// Refuses a run whose host memory does not fit before anything is allocated.
+void check_fits(const RunInput& in, bool compare) {
+  const std::string why = host_memory_shortfall(model_size(in.x.scene.model), *in.entry, in.integ, in.options,
+                                                compare ? pipelines().find("reference") : nullptr);
+  if (!why.empty()) throw BadInput(why);
 }
 
 }  // namespace
@@ -128,7 +121,7 @@ RunInput read_run_input(const RunArgs& a) {
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   if (a.compare && *a.compare != "cpu")
     throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
-  check_fits(in.x.scene.model, a.compare ? 2 : 1);
+  check_fits(in, bool(a.compare));
   in.model = build_model(in.x.scene);
   in.params = resolve_params(in.x.scene, in.model);
   return in;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "springs.hpp"
 #include "stage.hpp"
 #include "step_params.hpp"
 
@@ -172,14 +173,14 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
       for (int a = 0; a < 3; ++a)
         for (int q = 0; q < 3; ++q) trip.emplace_back(3 * r + a, 3 * col + q, b(a, q));
     };
-    for (int e = 0; e < m_.spring_count(); ++e) {
-      const int i = m_.spring_i[e], j = m_.spring_j[e];
+    for_each_spring(m_, [&](const SpringRef& sp) {
+      const int i = sp.i, j = sp.j;
       const E3 d = e3(s.x[i] - s.x[j]);
       const Real len = d.norm();
-      if (len == Real(0)) continue;
+      if (len == Real(0)) return;
       const E3 u = d / len;
       const M3 uu = u * u.transpose();
-      const Real ks = m_.spring_k(e), kd = m_.spring_kd(e), rest = m_.rest_length[e];
+      const Real ks = sp.k, kd = sp.kd, rest = sp.rest;
       const Real geo = std::max(Real(0), Real(1) - rest / len);
       const M3 K = -ks * (geo * (M3::Identity() - uu) + uu);  // df_i/dx_i
       const M3 D = -kd * uu;                                  // df_i/dv_i
@@ -193,7 +194,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
         add_block(i, j, -A);
         add_block(j, i, -A);
       }
-    }
+    });
     const bool spring_drag = p_.drag.active() && p_.drag.as_spring;
     for (int i = 0; i < n; ++i) {
       if (fixed(i)) {
@@ -273,19 +274,36 @@ std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p,
   return std::make_unique<CpuPipeline<float>>(s, parallel);
 }
 
+static Footprint cpu_footprint(const ModelSize& m, Integrator i, Precision p) {
+  const Schedule s = make_schedule(i);
+  const std::int64_t real = p == Precision::f64 ? 8 : 4, vec = 3 * real;
+  // slots (x, v), accelerations, the next state and Verlet's previous positions
+  Footprint f{m.nodes * vec * (2 * (1 + s.stage_states) + s.accel_slots + 3), 0};
+  if (s.rule == UpdateRule::backward_euler) {
+    // 3x3 blocks: triplets (two indices and a value), the matrix and its transposed copy while
+    // assembled; per node the diagonal blocks, K v0, and the solver's vectors (about 8 x 3n).
+    const std::int64_t nnz = 9 * (m.nodes + 2 * m.springs);
+    f.host += nnz * (8 + real) + 2 * nnz * (4 + real) + m.nodes * real * (9 + 3 + 24);
+  }
+  return f;
+}
+
 void add_cpu_pipelines(PipelineRegistry& r) {
   auto always = [] { return std::string(); };
   auto every = [](Integrator) { return std::string(); };
+  auto in = [](Precision p) {
+    return [p](const ModelSize& m, Integrator i, const PipelineOptions&) { return cpu_footprint(m, i, p); };
+  };
   const PipelineTraits as_cpu{}, in_double{.cpu_match = CpuMatch::rounding};
   r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", as_cpu, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }});
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }, {}, in(Precision::f32)});
   r.add({"omp", "OpenMP float, up to " + std::to_string(omp_get_max_threads()) + " threads of at least " +
                     std::to_string(CpuPipeline<float>::kNodesPerThread) +
                     " nodes each (the paper's optimised CPU); bitwise equal to cpu",
          as_cpu, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }});
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }, {}, in(Precision::f32)});
   r.add({"reference", "OpenMP double: the reference for tests and --compare", in_double, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }});
+         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }, {}, in(Precision::f64)});
 }
 
 }  // namespace deformlab

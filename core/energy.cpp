@@ -1,5 +1,6 @@
 #include "energy.hpp"
 
+#include "springs.hpp"
 #include "step_params.hpp"
 
 namespace deformlab {
@@ -12,8 +13,9 @@ Energy energy(const Model& m, const Params& p, const State& s) {
     e.kinetic += P::kinetic_energy(m.inv_mass[i], Vec3d(s.v[i]));
     e.field += P::field_energy(sp, m.inv_mass[i], Vec3d(s.x[i]));
   }
-  for (int k = 0; k < m.spring_count(); ++k)
-    e.spring += P::spring_energy(Vec3d(s.x[m.spring_i[k]]), Vec3d(s.x[m.spring_j[k]]), m.spring_k(k), m.rest_length[k]);
+  for_each_spring(m, [&](const SpringRef& r) {
+    e.spring += P::spring_energy(Vec3d(s.x[r.i]), Vec3d(s.x[r.j]), r.k, r.rest);
+  });
   return e;
 }
 

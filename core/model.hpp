@@ -1,5 +1,12 @@
 // Model: everything that does not change during a run (cf. MuJoCo's mjModel).
 // Sizes: n = node_count(), s = spring_count().
+//
+// Two shapes behind one interface (core/springs.hpp walks the springs of either):
+// - a grid (cloth or lattice) is its stencil: dimensions, spacing, per-kind constants, rest
+//   positions and inverse masses; no spring arrays and no adjacency. Host bytes per node:
+//   kGridBytesPerNode.
+// - a general model spells its springs out (spring_i/j, rest lengths, kinds, optional
+//   per-spring constants) with their CSR adjacency.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -7,6 +14,7 @@
 #include <vector>
 
 #include "grid_stencil.hpp"
+#include "memory.hpp"
 #include "vec3.hpp"
 
 namespace deformlab {
@@ -15,10 +23,8 @@ enum class SpringKind : std::uint8_t { structural = 0, shear = 1, flexion = 2 };
 inline constexpr int kSpringKinds = 3;
 const char* to_string(SpringKind k);
 
-// How nodes are laid out. Grids and lattices are built by the builders from the grid stencil
-// (grid_stencil.hpp), so every backend finds their neighbours by it; general models only
-// have the spring lists. A grid model with its topology set to general is run through its
-// spring lists, as any other general model.
+// How nodes are laid out. A grid's springs are its stencil (grid_stencil.hpp) at every node;
+// general models have spring lists (explicit_springs() turns a grid into one).
 enum class Topology : std::uint8_t { general, cloth_grid, lattice };
 
 struct Model {
@@ -29,11 +35,12 @@ struct Model {
   std::vector<Vec3f> rest_position;  // [n] rest (initial) positions
   std::vector<float> inv_mass;       // [n] 1/m; 0 marks a pinned node
 
+  // General models only (empty for grids):
   std::vector<std::int32_t> spring_i, spring_j;  // [s] end nodes, i < j
-  std::vector<float> rest_length;                // [s] grids: spacing x |offset|, one value per offset
+  std::vector<float> rest_length;                // [s]
   std::vector<SpringKind> kind;                  // [s]
-  std::array<float, kSpringKinds> stiffness{};   // per kind, N/m
-  std::array<float, kSpringKinds> damping{};     // per kind, along the spring axis, N s/m
+  std::array<float, kSpringKinds> stiffness{};   // per kind, N/m (all models)
+  std::array<float, kSpringKinds> damping{};     // per kind, along the spring axis, N s/m (all models)
   // [s] or empty: per-spring stiffness (N/m) and damping (N s/m) of general models, which
   // then replace the per-kind values. Grids keep per-kind values.
   std::vector<float> spring_stiffness, spring_damping;
@@ -43,17 +50,24 @@ struct Model {
   std::vector<std::int32_t> adj_offset, adj_spring, adj_node;
 
   int node_count() const { return int(rest_position.size()); }
-  int spring_count() const { return int(spring_i.size()); }
+  std::int64_t spring_count() const;  // grids: in closed form
   bool pinned(int v) const { return inv_mass[v] == 0.f; }
   bool grid() const { return topology != Topology::general; }
   bool volume() const { return topology == Topology::lattice || nz > 1; }  // lattice stencil
+  // Constants of general spring e.
   float spring_k(int e) const { return spring_stiffness.empty() ? stiffness[int(kind[e])] : spring_stiffness[e]; }
   float spring_kd(int e) const { return spring_damping.empty() ? damping[int(kind[e])] : spring_damping[e]; }
   // Recomputes adj_* from spring_i/j (ordered by spring index within each node).
   void build_adjacency();
   // Largest distance between two rest positions' bounding-box corners.
   float extent() const;
+  ModelSize size() const { return {node_count(), spring_count(), grid()}; }
+  // Bytes the model holds on the host (its arrays' capacities).
+  std::int64_t host_bytes() const;
 };
+
+// Host bytes per node of a grid model: rest position (12) and inverse mass (4).
+inline constexpr std::int64_t kGridBytesPerNode = 16;
 
 struct Material {
   std::array<float, kSpringKinds> stiffness{500.f, 500.f, 100.f};
@@ -81,7 +95,8 @@ void pin(Model& m, const std::vector<int>& nodes);
 // Rest length of a grid's springs along offset o: spacing x |o|.
 float grid_rest_length(const Model& m, const GridOffset& o);
 
-// Bytes a model of this many nodes and springs needs on the host (model + state).
-std::int64_t model_bytes(std::int64_t nodes, std::int64_t springs);
+// The same model with its springs spelled out as a general model (same springs, in the
+// order for_each_spring visits them).
+Model explicit_springs(const Model& grid);
 
 }  // namespace deformlab

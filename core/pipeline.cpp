@@ -1,5 +1,6 @@
 #include "pipeline.hpp"
 
+#include <sstream>
 #include <stdexcept>
 
 namespace deformlab {
@@ -19,6 +20,28 @@ std::string PipelineRegistry::names() const {
   std::string s;
   for (const auto& e : entries_) s += (s.empty() ? "" : ", ") + e.name;
   return s;
+}
+
+std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
+                                  const PipelineOptions& o, const PipelineEntry* reference) {
+  constexpr std::int64_t kMaxNodes = std::int64_t(1) << 30;
+  auto own = [&](const PipelineEntry& p) { return p.footprint ? p.footprint(m, i, o).host : 0; };
+  const std::int64_t model = model_host_bytes(m), state = state_host_bytes(m.nodes), pipe = own(e);
+  const std::int64_t ref = reference ? own(*reference) + state : 0;
+  const std::int64_t need = model + pipe + state + ref;
+  const auto limit = host_memory_limit();
+  if (m.nodes <= kMaxNodes && (!limit || need <= limit->bytes)) return {};
+  std::ostringstream os;
+  os << "a model of " << m.nodes << " nodes";
+  if (m.nodes > kMaxNodes) {
+    os << " exceeds the limit of 2^30 nodes";
+    return os.str();
+  }
+  os << " on " << e.name << " needs " << gib(need) << " of host memory (model " << gib(model) << ", pipeline "
+     << gib(pipe) << ", state " << gib(state);
+  if (reference) os << ", " << reference->name << " pipeline and state " << gib(ref);
+  os << "); " << limit->name << " leaves " << gib(limit->bytes);
+  return os.str();
 }
 
 }  // namespace deformlab

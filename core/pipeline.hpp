@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "integrator.hpp"
+#include "memory.hpp"
 #include "model.hpp"
 #include "params.hpp"
 #include "profiler.hpp"
@@ -71,7 +72,17 @@ struct PipelineEntry {
   std::function<std::string(Integrator)> unsupported;
   std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make;
   std::vector<std::string> options = {};  // option names it reads (see PipelineOptions)
+  // Bytes it allocates for a model of this size beyond the model itself: on the host and on
+  // its device (checked against the device's free memory when it is built).
+  std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint = {};
 };
+
+// Empty when a run of `e` on a model of size `m` fits in this machine's host memory, else one
+// line naming the need (the model, the pipeline's own host buffers, a state read back; with a
+// `reference`, as `deformlab run --compare` does, that pipeline and its state too) and the
+// limit that refuses it. The device's share is checked when the pipeline is built.
+std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
+                                  const PipelineOptions& o, const PipelineEntry* reference = nullptr);
 
 class PipelineRegistry {
  public:

@@ -5,14 +5,18 @@
 #include <limits>
 #include <sstream>
 
+#include "springs.hpp"
+
 namespace deformlab {
 
 double stability_limit(const Model& m, const Params& p, Integrator i) {
   double w2 = 0.0;  // Gershgorin bound on the largest squared angular frequency
-  for (int n = 0; n < m.node_count(); ++n) {
+  const int nodes = m.node_count();
+#pragma omp parallel for schedule(static) reduction(max : w2)
+  for (int n = 0; n < nodes; ++n) {
     if (m.inv_mass[n] == 0.f) continue;
     double k = 0.0;
-    for (int e = m.adj_offset[n]; e < m.adj_offset[n + 1]; ++e) k += 2.0 * m.spring_k(m.adj_spring[e]);
+    for_each_link(m, n, [&](int, float, float ks, float) { k += 2.0 * ks; });
     if (p.drag.active() && p.drag.as_spring && n == p.drag.node) k += p.drag.stiffness;
     w2 = std::max(w2, k * m.inv_mass[n]);
   }

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <type_traits>
 #include <stdexcept>
 
@@ -57,7 +58,7 @@ class ForceKernels {
       const auto entries = stencil_entries<float>(m);
       std::copy(entries.begin(), entries.end(), stencil_.e);
     } else if (o_.variant != Variant::scatter) {
-      std::vector<Link> links(m.adj_node.size());
+      std::vector<Link> links(m.adj_node.size());  // general models only
       for (std::size_t e = 0; e < links.size(); ++e) {
         const int sp = m.adj_spring[e];
         links[e] = {m.adj_node[e], m.rest_length[sp], m.spring_k(sp), m.spring_kd(sp)};
@@ -65,7 +66,7 @@ class ForceKernels {
       upload(offset_, m.adj_offset, "uploading the adjacency offsets");
       upload(links_, links, "uploading the adjacency");
     }
-    if (o_.variant == Variant::scatter) upload_springs();
+    if (o_.variant == Variant::scatter && !m.grid()) upload_springs();
   }
 
   // acc = a(x, v) for every node, queued on `stream`.
@@ -73,7 +74,13 @@ class ForceKernels {
     if (o_.variant == Variant::scatter) {
       check(cudaMemsetAsync(acc, 0, std::size_t(sp_.node_count) * sizeof(float4), stream), "clearing the force sums");
       const std::int64_t s = std::int64_t(springs_.size());
-      if (s > 0) {
+      if (model_.grid()) {
+        with_grid_flags([&](auto n, auto) {
+          const std::int64_t threads = std::int64_t(sp_.node_count) * (n() / 2);
+          dev::scatter_grid<n()><<<blocks_for(threads), kBlock, 0, stream>>>(sp_, stencil_, x, v, acc);
+        });
+        check_launch("launching the grid scatter kernel");
+      } else if (s > 0) {
         dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream>>>(springs_.get(), s, x, v, acc);
         check_launch("launching the scatter kernel");
       }
@@ -102,10 +109,10 @@ class ForceKernels {
     if (!h.empty()) check(cudaMemcpy(b.get(), h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice), what);
   }
   void upload_springs() {
-    const Model& m = model_;
+    const Model& m = model_;  // general models (grids have no spring list)
     std::vector<Spring> sp(m.spring_count());
-    for (int e = 0; e < m.spring_count(); ++e)
-      sp[e] = {m.spring_i[e], m.spring_j[e], m.rest_length[e], m.spring_k(e), m.spring_kd(e)};
+    for (std::size_t e = 0; e < sp.size(); ++e)
+      sp[e] = {m.spring_i[e], m.spring_j[e], m.rest_length[e], m.spring_k(int(e)), m.spring_kd(int(e))};
     require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
     upload(springs_, sp, "uploading the spring list");
   }
@@ -191,6 +198,22 @@ struct SpringEnergyOp {
     return PD::spring_energy(widen(dev::xyz(x[s.i])), widen(dev::xyz(x[s.j])), s.k, s.rest);
   }
 };
+// Grids: node u's own springs (the second half of its stencil).
+struct GridSpringEnergyOp {
+  dev::StepParams sp;
+  Stencil st;
+  const float4* x;
+  __device__ double operator()(int u) const {
+    const int i = u % sp.nx, j = (u / sp.nx) % sp.ny, k = u / (sp.nx * sp.ny), n = sp.stencil_count;
+    double e = 0.0;
+    for (int q = n / 2; q < n; ++q) {
+      const P::StencilEntry& o = st.e[q];
+      const int w = P::grid_neighbour(sp, i, j, k, o.di, o.dj, o.dk);
+      if (w >= 0) e += PD::spring_energy(widen(dev::xyz(x[u])), widen(dev::xyz(x[w])), o.k, o.rest);
+    }
+    return e;
+  }
+};
 
 class Impl final : public CudaPipeline, private ForceKernels, private ForceStage, private UpdateStage {
  public:
@@ -272,18 +295,21 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   Energy energy() override {
-    if (!springs_.get() && model_.spring_count() > 0) upload_springs();
+    if (!model_.grid() && !springs_.get() && model_.spring_count() > 0) upload_springs();
+    const auto policy = thrust::cuda::par.on(stream_);
     const NodeEnergy ne = thrust::transform_reduce(
-        thrust::cuda::par.on(stream_), thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
+        policy, thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
         NodeEnergyOp{x_[cur_].get(), v_[cur_].get(), step_params<double>(model_, p_)}, NodeEnergy{0.0, 0.0},
         AddNodeEnergy{});
-    SpringEnergyOp op{springs_.get(), x_[cur_].get()};
-    const double se = model_.spring_count() == 0
-                          ? 0.0
-                          : thrust::transform_reduce(thrust::cuda::par.on(stream_),
-                                                     thrust::counting_iterator<std::int64_t>(0),
-                                                     thrust::counting_iterator<std::int64_t>(model_.spring_count()),
-                                                     op, 0.0, thrust::plus<double>());
+    const double se =
+        model_.grid()
+            ? thrust::transform_reduce(policy, thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
+                                       GridSpringEnergyOp{sp_, stencil_, x_[cur_].get()}, 0.0, thrust::plus<double>())
+        : model_.spring_count() == 0
+            ? 0.0
+            : thrust::transform_reduce(policy, thrust::counting_iterator<std::int64_t>(0),
+                                       thrust::counting_iterator<std::int64_t>(model_.spring_count()),
+                                       SpringEnergyOp{springs_.get(), x_[cur_].get()}, 0.0, thrust::plus<double>());
     check(cudaStreamSynchronize(stream_), "reducing the energies");
     Energy e;
     e.kinetic = ne.kinetic;
@@ -308,29 +334,45 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
  private:
-  // Uploads go through the pipeline's stream, ordered after the steps already queued.
-  void copy_in(void* dst, const void* src, std::size_t bytes, const char* what) {
-    if (bytes == 0) return;
-    check(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream_), what);
+  // State transfers go through the pipeline's stream (ordered after the steps already queued)
+  // a chunk at a time through one pinned staging buffer: no second host copy of a state.
+  static constexpr int kChunk = kTransferChunkNodes;
+  float4* staging() {
+    if (!staging_) {
+      void* p = nullptr;
+      check(cudaMallocHost(&p, kChunk * sizeof(float4)), "allocating the transfer buffer");
+      staging_.reset(static_cast<float4*>(p));
+    }
+    return staging_.get();
+  }
+  // b[i] = make(i) for every node.
+  template <class Make>
+  void upload(Buffer<float4>& b, Make make, const char* what) {
+    float4* h = staging();
+    for (int base = 0; base < n_; base += kChunk) {
+      const int count = std::min(kChunk, n_ - base);
+      check(cudaStreamSynchronize(stream_), what);  // the previous chunk has left the staging buffer
+      for (int i = 0; i < count; ++i) h[i] = make(base + i);
+      check(cudaMemcpyAsync(b.get() + base, h, count * sizeof(float4), cudaMemcpyHostToDevice, stream_), what);
+    }
     check(cudaStreamSynchronize(stream_), what);
   }
   void upload_positions(Buffer<float4>& b, const std::vector<Vec3f>& x) {
-    std::vector<float4> h(n_);
-    for (int i = 0; i < n_; ++i) h[i] = make_float4(x[i].x, x[i].y, x[i].z, model_.inv_mass[i]);
-    copy_in(b.get(), h.data(), h.size() * sizeof(float4), "uploading positions");
+    upload(b, [&](int i) { return make_float4(x[i].x, x[i].y, x[i].z, model_.inv_mass[i]); }, "uploading positions");
   }
   void upload_vectors(Buffer<float4>& b, const std::vector<Vec3f>& v) {
-    std::vector<float4> h(n_);
-    for (int i = 0; i < n_; ++i) h[i] = make_float4(v[i].x, v[i].y, v[i].z, 0.f);
-    copy_in(b.get(), h.data(), h.size() * sizeof(float4), "uploading velocities");
+    upload(b, [&](int i) { return make_float4(v[i].x, v[i].y, v[i].z, 0.f); }, "uploading velocities");
   }
   std::vector<Vec3f> download(const Buffer<float4>& b) {
-    std::vector<float4> h(n_);
-    check(cudaMemcpyAsync(h.data(), b.get(), h.size() * sizeof(float4), cudaMemcpyDeviceToHost, stream_),
-          "reading the state back");
-    check(cudaStreamSynchronize(stream_), "reading the state back");
+    float4* h = staging();
     std::vector<Vec3f> out(n_);
-    for (int i = 0; i < n_; ++i) out[i] = {h[i].x, h[i].y, h[i].z};
+    for (int base = 0; base < n_; base += kChunk) {
+      const int count = std::min(kChunk, n_ - base);
+      check(cudaMemcpyAsync(h, b.get() + base, count * sizeof(float4), cudaMemcpyDeviceToHost, stream_),
+            "reading the state back");
+      check(cudaStreamSynchronize(stream_), "reading the state back");
+      for (int i = 0; i < count; ++i) out[base + i] = {h[i].x, h[i].y, h[i].z};
+    }
     return out;
   }
 
@@ -400,7 +442,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
     validate(su.params, su.model.node_count());
     if (o.variant == Variant::tiled || su.model.topology != Topology::general) check_tile(su.model, o.tile);
-    require_device_memory(bytes_needed(su.model, su.integrator, o),
+    require_device_memory(bytes_needed(su.model.size(), su.integrator, o),
                           std::string("the cuda-") + to_string(o.variant) + " pipeline for " +
                               std::to_string(su.model.node_count()) + " nodes (" +
                               std::string(info(su.integrator).name) + ")");
@@ -470,6 +512,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
+  struct FreeHost {
+    void operator()(float4* p) const { cudaFreeHost(p); }
+  };
+  std::unique_ptr<float4, FreeHost> staging_;
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t ev_[2] = {};

@@ -51,8 +51,11 @@ std::string unavailable();
 // Empty when the CUDA pipelines run this integrator, else the reason.
 std::string unsupported(Integrator i);
 
+// Device bytes of a general model's springs as variant v reads them (the CSR adjacency, or
+// the scatter's spring list); 0 for grids, whose springs are the stencil.
+std::int64_t spring_bytes(const ModelSize& m, Variant v);
 // Device memory a pipeline needs, bytes (state, stage slots, model arrays).
-std::int64_t bytes_needed(const Model& m, Integrator i, const Options& o);
+std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o);
 // Throws std::invalid_argument naming `what`, the bytes needed and the bytes free when the
 // device does not have `bytes` free.
 void require_device_memory(std::int64_t bytes, const std::string& what);

@@ -244,6 +244,27 @@ __global__ void scatter_springs(const Spring* __restrict__ springs, std::int64_t
   atomicAdd(&force[sp.j].z, -f.z);
 }
 
+// Grids: one thread per node and own stencil entry (the second half: one per spring), the
+// spring to that neighbour scattered as above. No spring list: the stencil is the model.
+template <int N>
+__global__ void scatter_grid(StepParams s, Stencil st, const float4* __restrict__ x, const float4* __restrict__ v,
+                             float4* force) {
+  const std::int64_t t = thread_index();
+  if (t >= std::int64_t(s.node_count) * (N / 2)) return;
+  const int u = int(t / (N / 2)), e = N / 2 + int(t % (N / 2));
+  const int i = u % s.nx, j = (u / s.nx) % s.ny, k = u / (s.nx * s.ny);
+  const P::StencilEntry& o = st.e[e];
+  const int w = P::grid_neighbour(s, i, j, k, o.di, o.dj, o.dk);
+  if (w < 0) return;
+  const Vec3f f = P::spring_force(xyz(x[u]), xyz(x[w]), xyz(v[u]), xyz(v[w]), o.k, o.kd, o.rest);
+  atomicAdd(&force[u].x, f.x);
+  atomicAdd(&force[u].y, f.y);
+  atomicAdd(&force[u].z, f.z);
+  atomicAdd(&force[w].x, -f.x);
+  atomicAdd(&force[w].y, -f.y);
+  atomicAdd(&force[w].z, -f.z);
+}
+
 __global__ void scatter_finish(StepParams s, const float4* __restrict__ x, const float4* __restrict__ v, float4* acc,
                                Vec3f drag_target) {
   const std::int64_t t = thread_index();

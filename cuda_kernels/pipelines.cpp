@@ -42,15 +42,19 @@ std::string unsupported(Integrator i) {
   return {};
 }
 
-std::int64_t bytes_needed(const Model& m, Integrator i, const Options& o) {
+std::int64_t spring_bytes(const ModelSize& m, Variant v) {
+  if (m.grid) return 0;
+  // CSR: offsets and two 16-byte links per spring; scatter: 5 words per spring
+  return v == Variant::scatter ? m.springs * 20 : (m.nodes + 1) * 4 + 2 * m.springs * 16;
+}
+
+std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   const Schedule s = make_schedule(i);
-  const std::int64_t n = m.node_count(), springs = m.spring_count(), f4 = 16;
+  const std::int64_t n = m.nodes, f4 = 16;
   std::int64_t b = n * 4 * f4;  // two (x, v) buffers
   b += n * 2 * f4 * s.stage_states;
   if (!(o.variant == Variant::fused && s.single_pass())) b += n * f4 * s.accel_slots;
-  if (m.topology == Topology::general && o.variant != Variant::scatter) b += (n + 1) * 4 + 2 * springs * 16;
-  if (o.variant == Variant::scatter) b += springs * 16;
-  return b;
+  return b + spring_bytes(m, o.variant);
 }
 
 double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
@@ -106,7 +110,10 @@ void add_cuda_pipelines(PipelineRegistry& r) {
            [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> {
              return cuda::make_pipeline(s, {v, cuda::tile_option(s.options), true});
            },
-           options});
+           options,
+           [v](const ModelSize& m, Integrator i, const PipelineOptions&) {
+             return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, {v})};
+           }});
   }
 }
 

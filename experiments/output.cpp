@@ -59,9 +59,20 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
       << "property float vx\nproperty float vy\nproperty float vz\n";
   if (faces) out << "element face " << nf << "\nproperty list uchar int vertex_indices\n";
   out << "end_header\n";
+  // Vertices, then faces made from the grid as they are written: a chunk of records at a time.
+  std::vector<char> buf;
+  auto flush = [&](bool last) {
+    if (buf.size() < (std::size_t(1) << 24) && !last) return;
+    out.write(buf.data(), std::streamsize(buf.size()));
+    buf.clear();
+  };
+  auto put = [&](const void* p, std::size_t bytes) {
+    buf.insert(buf.end(), static_cast<const char*>(p), static_cast<const char*>(p) + bytes);
+  };
   for (std::size_t i = 0; i < s.x.size(); ++i) {
     const float v[6] = {s.x[i].x, s.x[i].y, s.x[i].z, s.v[i].x, s.v[i].y, s.v[i].z};
-    out.write(reinterpret_cast<const char*>(v), sizeof v);
+    put(v, sizeof v);
+    flush(false);
   }
   for (int j = 0; faces && j + 1 < m.ny; ++j)
     for (int i = 0; i + 1 < m.nx; ++i) {
@@ -69,10 +80,12 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
       const std::int32_t tris[2][3] = {{a, c, b}, {b, c, d}};
       for (const auto& t : tris) {
         const unsigned char three = 3;
-        out.write(reinterpret_cast<const char*>(&three), 1);
-        out.write(reinterpret_cast<const char*>(t), sizeof t);
+        put(&three, 1);
+        put(t, sizeof t);
       }
+      flush(false);
     }
+  flush(true);
   if (!out) throw std::runtime_error("failed writing " + file.string());
 }
 
@@ -107,8 +120,10 @@ nlohmann::json machine_info() {
       break;
     }
   j["hardware_threads"] = std::thread::hardware_concurrency();
-  const std::int64_t mem = available_memory_bytes();
-  if (mem >= 0) j["memory_available_bytes"] = mem;
+  if (const auto limit = host_memory_limit()) {
+    j["memory_available_bytes"] = limit->bytes;
+    j["memory_limit"] = limit->name;
+  }
   return j;
 }
 
@@ -126,20 +141,10 @@ nlohmann::json build_info() {
                                 std::to_string(NLOHMANN_JSON_VERSION_PATCH)}};
 }
 
-std::int64_t available_memory_bytes() {
-  std::ifstream in("/proc/meminfo");
-  std::string key;
-  std::int64_t kb = 0;
-  std::string unit;
-  while (in >> key >> kb >> unit)
-    if (key == "MemAvailable:") return kb * 1024;
-  return -1;
-}
-
 ModelSize model_size(const ModelSpec& ms) {
   const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
                                                   : cloth_spring_counts(ms.nx, ms.ny);
-  return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2]};
+  return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2], true};
 }
 
 }  // namespace deformlab

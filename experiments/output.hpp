@@ -47,13 +47,7 @@ void write_json(const std::filesystem::path& file, const nlohmann::json& j);
 nlohmann::json machine_info();
 nlohmann::json build_info();
 
-// Bytes of memory available to this process now (MemAvailable), or -1 if unknown.
-std::int64_t available_memory_bytes();
-
 // The nodes and springs a model spec builds, counted without building it.
-struct ModelSize {
-  std::int64_t nodes = 0, springs = 0;
-};
 ModelSize model_size(const ModelSpec& ms);
 
 }  // namespace deformlab

@@ -38,7 +38,7 @@ const Known kKnown[] = {
     {"cuda-naive", "CUDA, one thread per node gathering from global memory", "CUDA",
      on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
     {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false)},
-    {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute)},
+    {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute), {"window"}},
     {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL", on(Engine::gl_transform_feedback)},
     {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL",
      hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile"}},

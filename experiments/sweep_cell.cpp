@@ -29,17 +29,15 @@ json not_applicable(json r, const std::string& why) {
 
 // Sizes the scene's model to the cell and records its nodes and springs in `r`; returns why
 // it does not fit here, else "".
-std::string size_model(Scene& scene, const Cell& c, json& r) {
+std::string size_model(Scene& scene, const Cell& c, const PipelineEntry& e, Integrator i, json& r) {
   ModelSpec& ms = scene.model;
   ms.nx = ms.ny = c.size;
   ms.nz = ms.topology == Topology::lattice ? c.size : 1;
   const ModelSize size = model_size(ms);
   r["nodes"] = size.nodes;
   r["springs"] = size.springs;
-  const std::int64_t need = model_bytes(size.nodes, size.springs), have = available_memory_bytes();
-  if (size.nodes <= (std::int64_t(1) << 30) && (have <= 0 || need <= have)) return {};
-  return "does not fit: needs about " + std::to_string(need >> 20) + " MiB of host memory, " +
-         std::to_string(have >> 20) + " MiB available";
+  const std::string why = host_memory_shortfall(size, e, i, c.options);
+  return why.empty() ? why : "does not fit: " + why;
 }
 
 const Model& cached_model(ModelCache& cache, const Scene& scene, int size) {
@@ -173,7 +171,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
   if (auto why = e.unavailable(); !why.empty()) return not_applicable(r, why);
   if (auto why = e.unsupported(integ); !why.empty()) return not_applicable(r, why);
   Scene scene = x.scene;
-  if (auto why = size_model(scene, c, r); !why.empty()) return not_applicable(r, why);
+  if (auto why = size_model(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
   try {
     const Model& m = cached_model(cache, scene, c.size);
     const Params p = resolve_params(scene, m);

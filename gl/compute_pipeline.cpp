@@ -20,13 +20,13 @@ class ComputePipeline final : public GlPipeline {
     const int need = shared ? 9 : 8;
     if (blocks < need)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
-    GLint max_x = 0, max_y = 0;
-    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_x);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_x_);
+    GLint max_y = 0;
     glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &max_y);
-    groups_ = dispatch_shape((std::int64_t(n_) + 255) / 256, max_x);
-    if (groups_[1] > std::uint32_t(max_y))
-      throw std::invalid_argument(name_ + ": " + std::to_string(n_) + " nodes need more work groups than this driver's " +
-                                  std::to_string(max_x) + " x " + std::to_string(max_y));
+    for (const NodeWindow& w : windows_)
+      if (dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_)[1] > std::uint32_t(max_y))
+        throw std::invalid_argument(name_ + ": " + std::to_string(w.count) + " nodes need more work groups than " +
+                                    "this driver's " + std::to_string(max_x_) + " x " + std::to_string(max_y));
     init();
   }
 
@@ -35,19 +35,29 @@ class ComputePipeline final : public GlPipeline {
     return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines);
   }
 
+  // Window by window (node_windows): the inputs bound over the nodes the window reads, the
+  // outputs over the nodes it writes; step.comp offsets its indices by both.
   void run_pass(GLuint program, const PassIO& io) override {
     const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
-    for (int k = 0; k < 5; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, in[k]->id());
-    for (int k = 0; k < io.outputs; ++k) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5 + k, io.out[k]->id());
-    if (io.forces_acc) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, io.forces_acc->id());
     glUseProgram(program);
-    glDispatchCompute(groups_[0], groups_[1], 1);
+    for (const NodeWindow& w : windows_) {
+      for (int k = 0; k < 5; ++k)
+        if (in[k]->id()) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
+      for (int k = 0; k < io.outputs; ++k) bind_nodes(GLuint(5 + k), *io.out[k], w.first, w.count);
+      if (io.forces_acc) bind_nodes(8, *io.forces_acc, w.read_first, w.read_count);
+      glUniform1i(kFirst, w.first);
+      glUniform1i(kCount, w.count);
+      glUniform1i(kReadFirst, w.read_first);
+      const auto groups = dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_);
+      glDispatchCompute(groups[0], groups[1], 1);
+    }
     // Later passes read this one's outputs as storage buffers and (earlier stages) as textures.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     glUseProgram(0);
   }
 
-  std::array<std::uint32_t, 2> groups_{};  // work groups of 256 nodes, x by y (step.comp)
+  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2;  // uniform locations in step.comp
+  GLint max_x_ = 0;  // work groups along x
 };
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "core/step_params.hpp"
@@ -22,7 +24,44 @@ struct SimBlock {
 static_assert(sizeof(P::StepParams) == 208 && sizeof(P::StencilEntry) == 32 && offsetof(SimBlock, stencil) == 208,
               "StepParams and StencilEntry must keep the std140 layout of shaders/sim.glsl");
 
+// Nodes between a node and its farthest spring neighbour in the node order (general: any).
+std::int64_t spring_reach(const Model& m) {
+  if (!m.grid()) return m.node_count();
+  std::int64_t reach = 0;
+  for (int e = 0; e < grid_stencil_size(m.volume()); ++e) {
+    const GridOffset o = grid_offset(m.volume(), e);
+    reach = std::max(reach, std::abs(o.di + std::int64_t(o.dj) * m.nx + std::int64_t(o.dk) * m.nx * m.ny));
+  }
+  return reach;
+}
+
 }  // namespace
+
+std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align) {
+  if (n <= max_nodes) return {{0, int(n), 0, int(n)}};
+  const std::int64_t width = (max_nodes - 2 * reach - 2 * align) / align * align;
+  if (width < align)
+    throw std::invalid_argument("a model of " + std::to_string(n) + " nodes whose springs reach " +
+                                std::to_string(reach) + " nodes apart does not fit in storage-buffer windows of " +
+                                std::to_string(max_nodes) + " nodes");
+  std::vector<NodeWindow> out;
+  for (std::int64_t first = 0; first < n; first += width) {
+    const std::int64_t count = std::min(width, n - first);
+    const std::int64_t read_first = std::max<std::int64_t>(0, first - reach) / align * align;
+    const std::int64_t read_end = std::min(n, first + count + reach);
+    out.push_back({int(first), int(count), int(read_first), int(read_end - read_first)});
+  }
+  return out;
+}
+
+Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
+  const Schedule s = make_schedule(i);
+  const std::int64_t n = m.nodes, node_buffers = 4 + (s.rule == UpdateRule::verlet ? 2 : 0) + 3 * s.stage_states +
+                                                 (outside_forces ? 1 : 0);
+  const std::int64_t chunk = 16 * std::min<std::int64_t>(n, kTransferChunkNodes);  // staging, host and GPU
+  const std::int64_t adjacency = m.grid ? 0 : (n + 1) * 4 + 2 * m.springs * 16;
+  return {chunk, n * 16 * node_buffers + adjacency + chunk};
+}
 
 GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared)
     : name_(std::move(name)),
@@ -34,14 +73,16 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   context();
   n_ = m_.node_count();
   if (n_ < 1) throw std::invalid_argument(name_ + ": the model has no nodes");
-  // Node states are texture buffers of one texel per node; general models also have their
-  // adjacency in texture buffers (two links per spring).
   GLint max_texels = 0;
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
-  const std::int64_t adjacency = m_.grid() ? 0 : std::int64_t(2) * m_.spring_count();
-  if (adjacency > max_texels || n_ + 1 > max_texels)
-    throw std::invalid_argument(name_ + ": the model needs texture buffers larger than this driver's " +
-                                std::to_string(max_texels) + " texels");
+  max_texels_ = max_texels;
+  if (!m_.grid()) {  // general models read their adjacency through texture buffers
+    require_texels(n_ + 1, "the adjacency offsets");
+    require_texels(2 * m_.spring_count(), "the adjacency (two links per spring)");
+  }
+  if (sched_.stage_states > 0) require_texels(n_, "the Runge-Kutta stage slopes");
+  plan_windows(s.options);
+  require_memory(footprint(m_.size(), s.integrator, bool(shared_)).device);
   plan();
   make_buffers();
   upload_params();
@@ -51,6 +92,51 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
 }
 
 GlPipeline::~GlPipeline() = default;
+
+void GlPipeline::require_texels(std::int64_t texels, const std::string& what) const {
+  if (texels > max_texels_)
+    throw std::invalid_argument(name_ + ": " + what + " need texture buffers of " + std::to_string(texels) +
+                                " texels; this driver's limit is " + std::to_string(max_texels_) +
+                                " (GL_MAX_TEXTURE_BUFFER_SIZE)");
+}
+
+void GlPipeline::require_memory(std::int64_t bytes) const {
+  std::optional<MemoryLimit> limit;
+  if (GLEW_NVX_gpu_memory_info) {
+    GLint kb = 0;
+    glGetIntegerv(GL_GPU_MEMORY_INFO_CURRENT_AVAILABLE_VIDMEM_NVX, &kb);
+    limit = MemoryLimit{std::int64_t(kb) * 1024, "the GPU's free memory (GL_NVX_gpu_memory_info)"};
+  } else if (context().software) {
+    limit = host_memory_limit();  // a software renderer's buffers are host memory
+  }
+  if (limit && bytes > limit->bytes)
+    throw std::invalid_argument(name_ + " for " + std::to_string(n_) + " nodes needs " + gib(bytes) +
+                                " of GL buffers; " + limit->name + " leaves " + gib(limit->bytes));
+}
+
+void GlPipeline::plan_windows(const PipelineOptions& o) {
+  GLint64 block = 0;
+  GLint align = 1;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &align);
+  max_block_nodes_ = block / 16;
+  std::int64_t window = max_block_nodes_;
+  if (const auto it = o.find("window"); it != o.end()) {
+    try {
+      std::size_t used = 0;
+      window = std::stoll(it->second, &used);
+      if (used != it->second.size() || window < 1 || window > max_block_nodes_) throw std::out_of_range("");
+    } catch (const std::logic_error&) {
+      throw std::invalid_argument(name_ + ": option window '" + it->second + "' is not a node count from 1 to " +
+                                  std::to_string(max_block_nodes_) + " (GL_MAX_SHADER_STORAGE_BLOCK_SIZE / 16)");
+    }
+  }
+  windows_ = node_windows(n_, spring_reach(m_), window, std::lcm<std::int64_t>(std::max(align, 1), 16) / 16);
+}
+
+void GlPipeline::bind_nodes(GLuint index, const NodeBuffer& b, int first, int count) {
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, index, b.id(), GLintptr(first) * 16, GLsizeiptr(count) * 16);
+}
 
 void GlPipeline::make_buffers() {
   const std::size_t bytes = std::size_t(n_) * 16;
@@ -62,7 +148,7 @@ void GlPipeline::make_buffers() {
       b.external = shared_(bytes, NodeRole::state);
     else
       b.buf = make_buffer(bytes);
-    b.tex = make_texture_buffer(b.id(), GL_RGBA32F);
+    if (n_ <= max_texels_) b.tex = make_texture_buffer(b.id(), GL_RGBA32F);  // else no pass reads it
     return b;
   };
   for (int k = 0; k < 2; ++k) {
@@ -77,7 +163,7 @@ void GlPipeline::make_buffers() {
   }
   if (shared_) {
     forces_acc_.external = shared_(bytes, NodeRole::accelerations);
-    forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
+    if (n_ <= max_texels_) forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
   }
 }
 
@@ -152,22 +238,28 @@ void GlPipeline::set_state(const State& s) {
   if (s.x.size() != n || s.v.size() != n || (!s.x_prev.empty() && s.x_prev.size() != n))
     throw std::invalid_argument("state size does not match the model");
   context();
+  // A chunk at a time through one staging buffer, then a shader copy (see shaders/copy.comp:
+  // buffers of the external force stage may be memory imported from another API).
+  const int chunk = int(std::min<std::int64_t>(kTransferChunkNodes, max_block_nodes_));
+  std::vector<float> data(4 * std::size_t(std::min(chunk, n_)));
+  const Buffer staging = make_buffer(data.size() * 4);
   auto upload = [&](const NodeBuffer& b, const std::vector<Vec3f>& src, bool inv_mass) {
-    std::vector<float> data(4 * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      data[4 * i] = src[i].x;
-      data[4 * i + 1] = src[i].y;
-      data[4 * i + 2] = src[i].z;
-      data[4 * i + 3] = inv_mass ? m_.inv_mass[i] : 0.f;
-    }
-    // Through a shader copy (see shaders/copy.comp): buffers of the external force stage
-    // may be memory imported from another API, with immutable storage.
-    const Buffer staging = make_buffer(data.size() * 4, data.data());
     glUseProgram(copy_.id());
-    glUniform1i(copy_n_, n_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, staging.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, b.id());
-    glDispatchCompute(GLuint(std::min(65535, (n_ + 255) / 256)), 1, 1);
+    for (int base = 0; base < n_; base += chunk) {
+      const int count = std::min(chunk, n_ - base);
+      for (int i = 0; i < count; ++i) {
+        const Vec3f& p = src[std::size_t(base + i)];
+        data[4 * std::size_t(i)] = p.x;
+        data[4 * std::size_t(i) + 1] = p.y;
+        data[4 * std::size_t(i) + 2] = p.z;
+        data[4 * std::size_t(i) + 3] = inv_mass ? m_.inv_mass[std::size_t(base + i)] : 0.f;
+      }
+      glNamedBufferSubData(staging.id(), 0, GLsizeiptr(count) * 16, data.data());
+      glUniform1i(copy_n_, count);
+      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, staging.id(), 0, GLsizeiptr(count) * 16);
+      bind_nodes(1, b, base, count);
+      glDispatchCompute(GLuint(std::min(65535, (count + 255) / 256)), 1, 1);
+    }
     glUseProgram(0);
   };
   upload(x_[cur_], s.x, true);
@@ -185,11 +277,16 @@ void GlPipeline::set_state(const State& s) {
 State GlPipeline::state() {
   context();
   const std::size_t n = std::size_t(n_);
-  std::vector<float> data(4 * n);
+  const int chunk = std::min(kTransferChunkNodes, n_);
+  std::vector<float> data(4 * std::size_t(chunk));
   auto download = [&](const NodeBuffer& b, std::vector<Vec3f>& out) {
-    read_buffer(b.id(), data.size() * 4, data.data());
     out.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out[i] = {data[4 * i], data[4 * i + 1], data[4 * i + 2]};
+    for (int base = 0; base < n_; base += chunk) {
+      const int count = std::min(chunk, n_ - base);
+      read_buffer(b.id(), std::size_t(base) * 16, std::size_t(count) * 16, data.data());
+      for (int i = 0; i < count; ++i)
+        out[std::size_t(base + i)] = {data[4 * std::size_t(i)], data[4 * std::size_t(i) + 1], data[4 * std::size_t(i) + 2]};
+    }
   };
   State s;
   s.t = t_;
@@ -295,12 +392,14 @@ double GlPipeline::max_displacement() {
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, result_.id());
   glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, 4, &zero);
   glUseProgram(reduce_.id());
-  glUniform1i(reduce_n_, n_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, v_[cur_].id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
-  glDispatchCompute(GLuint(std::min(1024, (n_ + 255) / 256)), 1, 1);
+  for (const NodeWindow& w : windows_) {
+    glUniform1i(reduce_n_, w.count);
+    bind_nodes(0, v_[cur_], w.first, w.count);
+    glDispatchCompute(GLuint(std::min(1024, (w.count + 255) / 256)), 1, 1);
+  }
   std::uint32_t bits = 0;
-  read_buffer(result_.id(), 4, &bits);
+  read_buffer(result_.id(), 0, 4, &bits);
   glUseProgram(0);
   check(name_ + " displacement reduction");
   float d;

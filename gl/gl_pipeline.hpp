@@ -19,6 +19,21 @@ namespace deformlab::gl {
 enum class NodeRole { state, accelerations };
 using SharedAllocator = std::function<GLuint(std::size_t bytes, NodeRole role)>;
 
+// A range of nodes one storage-buffer dispatch covers: it writes [first, first + count) and
+// reads [read_first, read_first + read_count), the written nodes and their springs' reach.
+struct NodeWindow {
+  int first, count, read_first, read_count;
+};
+// Windows over n nodes whose bound ranges hold at most max_nodes nodes each and start at
+// multiples of align nodes (one window when n fits); throws std::invalid_argument when the
+// reach leaves no room. A driver addresses a storage buffer binding with 32-bit offsets
+// (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): larger models run window by window.
+std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align);
+
+// Host and GPU bytes of a GL pipeline beyond the model (with an outside force stage: its
+// accelerations buffer too).
+Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces);
+
 class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
  public:
   ~GlPipeline() override;
@@ -72,8 +87,14 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
-  // buffers it allocates, instead of evaluating forces.
+  // buffers it allocates, instead of evaluating forces. Option "window": nodes per
+  // storage-buffer window (default: the driver's limit).
   GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared = {});
+  // Throws std::invalid_argument naming the driver's limit when `texels` texels do not fit
+  // in one texture buffer.
+  void require_texels(std::int64_t texels, const std::string& what) const;
+  // Binds nodes [first, first + count) of `b` to storage binding `index`.
+  static void bind_nodes(GLuint index, const NodeBuffer& b, int first, int count);
   // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
   void init();
   // `defines` selects the pass kind, its stage, the update rule and the neighbour mode (see
@@ -84,6 +105,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   virtual void on_set_state() {}
 
   int n_ = 0;
+  std::vector<NodeWindow> windows_;  // of the storage-buffer passes
   const std::string name_;
   const SharedAllocator shared_;
   NodeBuffer forces_acc_;  // what the outside force stage writes
@@ -104,6 +126,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   void upload_adjacency();
   void plan();
   void bind_textures(int stage) const;  // earlier stages' slopes and the adjacency
+  void plan_windows(const PipelineOptions& o);
+  // Throws std::invalid_argument when the GPU (or, for a software renderer, the host) has
+  // less free memory than `bytes`.
+  void require_memory(std::int64_t bytes) const;
 
   const Model& m_;
   const Params p_;
@@ -116,6 +142,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   Texture adj_offset_tex_, links_tex_;
   Program reduce_, copy_;
   GLint reduce_n_ = -1, copy_n_ = -1;
+  std::int64_t max_texels_ = 0, max_block_nodes_ = 0;
   Profiler* prof_ = nullptr;
   TimerSpans spans_;  // the profiled steps
   int cur_ = 0;

@@ -33,10 +33,10 @@ Texture make_texture_buffer(GLuint buffer, GLenum format) {
   return Texture(id);
 }
 
-void read_buffer(GLuint buffer, std::size_t bytes, void* out) {
+void read_buffer(GLuint buffer, std::size_t offset, std::size_t bytes, void* out) {
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   glBindBuffer(GL_COPY_READ_BUFFER, buffer);
-  glGetBufferSubData(GL_COPY_READ_BUFFER, 0, GLsizeiptr(bytes), out);
+  glGetBufferSubData(GL_COPY_READ_BUFFER, GLintptr(offset), GLsizeiptr(bytes), out);
   glBindBuffer(GL_COPY_READ_BUFFER, 0);
   check("reading a buffer back");
 }

@@ -47,7 +47,7 @@ using Program = Handle<delete_program>;
 Buffer make_buffer(std::size_t bytes, const void* data = nullptr);
 // A texture buffer view of `buffer` with the given texel format (GL_RGBA32F, GL_R32I, ...).
 Texture make_texture_buffer(GLuint buffer, GLenum format);
-void read_buffer(GLuint buffer, std::size_t bytes, void* out);
+void read_buffer(GLuint buffer, std::size_t offset, std::size_t bytes, void* out);
 
 struct ShaderStage {
   GLenum type;       // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER

@@ -16,10 +16,12 @@ void add_gl_pipelines(PipelineRegistry& r) {
   };
   // Deterministic, and equal to the CPU within rounding (the GPU's arithmetic differs).
   auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
+  auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) { return gl::footprint(m, i, false); };
+  // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows).
   r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,
-         unsupported("glsl-compute"), gl::make_compute_pipeline});
+         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window"}, footprint});
   r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", on(Engine::gl_transform_feedback),
-         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline});
+         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {}, footprint});
 }
 
 }  // namespace deformlab

@@ -13,6 +13,7 @@ class TfPipeline final : public GlPipeline {
  public:
   TfPipeline(const PipelineSetup& s, const SharedAllocator& shared)
       : GlPipeline(s, shared ? "hybrid" : "glsl-tf", shared) {
+    require_texels(n_, "the node states (read by the vertex shader)");
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
     if (separate < 3) throw std::invalid_argument(name_ + " needs 3 separate transform feedback buffers");

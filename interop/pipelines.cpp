@@ -1,6 +1,8 @@
 #include "pipelines.hpp"
 
+#include "cuda_kernels/cuda_pipeline.hpp"
 #include "gl/context.hpp"
+#include "gl/gl_pipeline.hpp"
 #include "hybrid.hpp"
 
 namespace deformlab {
@@ -14,18 +16,27 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   // CUDA forces, a GL update: equal to the CPU within rounding.
   auto updating_on = [](Engine e) { return PipelineTraits{Engine::cuda, e, true, CpuMatch::rounding}; };
   const std::vector<std::string> options = {"interop", "force", "tile"};
+  // The GL update's buffers (the states the forces read and the accelerations shared with
+  // CUDA) and the CUDA force pass's springs.
+  auto footprint = [](Update u) {
+    return [u](const ModelSize& m, Integrator i, const PipelineOptions& o) {
+      Footprint f = gl::footprint(m, i, true);
+      f.device += cuda::spring_bytes(m, interop::hybrid_options(o, u).force);
+      return f;
+    };
+  };
   r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile)",
          updating_on(Engine::gl_transform_feedback), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
          },
-         options});
+         options, footprint(Update::transform_feedback)});
   r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile)",
          updating_on(Engine::gl_compute), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
          },
-         options});
+         options, footprint(Update::compute)});
 }
 
 }  // namespace deformlab

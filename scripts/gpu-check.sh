@@ -3,7 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments" to run, default all),
+# Environment: PARTS (which of "tests sanitizers bench experiments scale" to run, default all
+# but scale),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
@@ -18,6 +19,7 @@ max=${MAX_SIZE:-4096}
 mkdir -p "$out/results"
 summary=()
 parts=${PARTS:-tests sanitizers bench experiments}
+app="$build/app/deformlab"
 part() { [[ " $parts " == *" $1 "* ]]; }
 
 if part tests; then
@@ -50,12 +52,39 @@ if part bench; then
   bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
 fi
 
-app="$build/app/deformlab"
 if part experiments; then
   "$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
   for x in ${EXPERIMENTS-table2 table3 tiles interop swap}; do
     "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
     summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
+  done
+fi
+
+# The largest grids: 20 steps with the stop rule checked every step (state.ply left out: 13 GB
+# at 16384^2), device memory sampled by nvidia-smi; then --compare cpu at 1024^2 and 96^3.
+scale_run() {  # name, then run arguments
+  local name=$1; shift
+  nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits -lms 100 >"$out/scale-$name.gpumem" 2>/dev/null &
+  local smi=$!
+  "$app" run --steps 20 --check-every 1 --no-state --out "/tmp/scale-$name" "$@" >"$out/scale-$name.log" 2>&1
+  local rc=$?
+  kill "$smi" 2>/dev/null
+  cp "/tmp/scale-$name/manifest.json" "$out/scale-$name.json" 2>/dev/null
+  rm -rf "/tmp/scale-$name"
+  local peak=$(sort -n "$out/scale-$name.gpumem" | tail -1)
+  summary+=("scale $name (rc $rc, GPU peak ${peak} MiB): $(grep -E 'median|memory:|error|refused|limit' "$out/scale-$name.log" | tr -s ' ' | tr '\n' ' ')")
+}
+if part scale; then
+  for p in cuda-fused cuda-naive glsl-compute; do
+    scale_run "$p-cloth16384" --pipeline "$p" --grid 16384x16384
+    scale_run "$p-lattice512" --pipeline "$p" --lattice 512x512x512
+  done
+  scale_run glsl-tf-cloth11585 --pipeline glsl-tf --grid 11585x11585
+  scale_run glsl-tf-lattice512 --pipeline glsl-tf --lattice 512x512x512
+  scale_run glsl-tf-cloth16384 --pipeline glsl-tf --grid 16384x16384
+  for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
+    scale_run "$p-compare1024" --pipeline "$p" --grid 1024x1024 --compare cpu
+    scale_run "$p-compare96" --pipeline "$p" --lattice 96x96x96 --compare cpu
   done
 fi
 

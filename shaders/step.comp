@@ -1,6 +1,11 @@
 #version 430 core
-// The same step as step.vert, as a compute shader over shader storage buffers.
+// The same step as step.vert, as a compute shader over shader storage buffers. A dispatch
+// covers one window of nodes (gl/gl_pipeline.hpp, node_windows): the inputs are bound from
+// node u_read_first, the outputs from node u_first.
 layout(local_size_x = 256) in;
+layout(location = 0) uniform int u_first;       // first node this dispatch writes
+layout(location = 1) uniform int u_count;       // nodes it writes
+layout(location = 2) uniform int u_read_first;  // first node of the bound inputs
 
 layout(std430, binding = 0) readonly buffer S0X { vec4 s0_x[]; };  // current state
 layout(std430, binding = 1) readonly buffer S0V { vec4 s0_v[]; };
@@ -11,29 +16,30 @@ layout(std430, binding = 5) writeonly buffer O0 { vec4 out0[]; };
 layout(std430, binding = 6) writeonly buffer O1 { vec4 out1[]; };
 layout(std430, binding = 7) writeonly buffer O2 { vec4 out2[]; };
 
-vec4 src_x(int j) { return src_x_[j]; }
-vec4 src_v(int j) { return src_v_[j]; }
+vec4 src_x(int j) { return src_x_[j - u_read_first]; }
+vec4 src_v(int j) { return src_v_[j - u_read_first]; }
 #ifdef EXTERNAL_FORCES
 layout(std430, binding = 8) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
-vec4 forces_acc(int i) { return forces_acc_[i]; }
+vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 #endif
 
 #include "sim.glsl"
 
 void main() {
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
-  int i = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
-  if (i >= params.node_count) return;
+  int l = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
+  if (l >= u_count) return;
+  int i = u_first + l, r = i - u_read_first;
 #if PASS == PASS_ONE && RULE == RULE_VERLET
-  vec4 xp = s0_p[i];
+  vec4 xp = s0_p[r];
 #else
   vec4 xp = vec4(0.0);
 #endif
   vec4 o0, o1, o2;
-  node_pass(i, s0_x[i], s0_v[i], xp, o0, o1, o2);
-  out0[i] = o0;
-  out1[i] = o1;
+  node_pass(i, s0_x[r], s0_v[r], xp, o0, o1, o2);
+  out0[l] = o0;
+  out1[l] = o1;
 #if PASS == PASS_STAGE || (PASS == PASS_ONE && RULE == RULE_VERLET)
-  out2[i] = o2;
+  out2[l] = o2;
 #endif
 }

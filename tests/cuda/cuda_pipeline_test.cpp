@@ -145,10 +145,15 @@ TEST(CudaPipeline, RefusesASizeThatDoesNotFit) {
     EXPECT_NE(what.find("bytes are free"), std::string::npos) << what;
   }
   const Model m = make_model(kShapes[4]);
-  EXPECT_NO_THROW(cuda::require_device_memory(cuda::bytes_needed(m, Integrator::rk4, {}), "a 256x256 cloth"));
+  EXPECT_NO_THROW(cuda::require_device_memory(cuda::bytes_needed(m.size(), Integrator::rk4, {}), "a 256x256 cloth"));
   // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers.
-  EXPECT_EQ(cuda::bytes_needed(m, Integrator::rk4, options(Variant::naive)), m.node_count() * 16 * (4 + 6 + 4));
-  EXPECT_EQ(cuda::bytes_needed(m, Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 4);
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::rk4, options(Variant::naive)), m.node_count() * 16 * (4 + 6 + 4));
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 4);
+  // Grids need no spring arrays, not even for scatter; a general model's adjacency or spring list adds its bytes.
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::scatter)), m.node_count() * 16 * 5);
+  const ModelSize g = explicit_springs(m).size();
+  EXPECT_EQ(cuda::bytes_needed(g, Integrator::verlet, options(Variant::scatter)),
+            m.node_count() * 16 * 5 + g.springs * 20);
 }
 
 // ---- no device needed ----

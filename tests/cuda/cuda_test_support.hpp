@@ -19,10 +19,7 @@ namespace deformlab::test {
   } while (0)
 
 // The same springs, seen as a general model: the kernels then gather over the CSR adjacency.
-inline Model as_general(Model m) {
-  m.topology = Topology::general;
-  return m;
-}
+inline Model as_general(const Model& m) { return explicit_springs(m); }
 
 
 inline double max_abs_position(const State& s) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cpu_backend.hpp"
+#include "core/springs.hpp"
 #include "core/stage.hpp"
 #include "core/step_params.hpp"
 #include "gl/gl_pipeline.hpp"
@@ -17,7 +18,7 @@ namespace deformlab::test {
 namespace {
 
 // Accelerations on the host with the per-node physics (core/node_physics.h), summed in
-// adjacency order.
+// stencil order.
 class HostForces final : public ForceStage {
  public:
   HostForces(const Model& m, const Params& p) : m_(m), p_(p) {}
@@ -34,8 +35,8 @@ class HostForces final : public ForceStage {
     const auto [x, v] = gl_->slot_buffers(src);
     const std::size_t n = std::size_t(m_.node_count());
     std::vector<float> xs(4 * n), vs(4 * n), a(4 * n, 0.f);
-    gl::read_buffer(x, xs.size() * 4, xs.data());
-    gl::read_buffer(v, vs.size() * 4, vs.data());
+    gl::read_buffer(x, 0, xs.size() * 4, xs.data());
+    gl::read_buffer(v, 0, vs.size() * 4, vs.data());
     auto at = [](const std::vector<float>& b, int i) { return Vec3f{b[4 * i], b[4 * i + 1], b[4 * i + 2]}; };
     using P = Physics<float>;
     const P::StepParams sp = step_params<float>(m_, p_);
@@ -43,10 +44,9 @@ class HostForces final : public ForceStage {
     for (int i = 0; i < int(n); ++i) {
       const float w = m_.inv_mass[i];
       Vec3f f{};
-      for (int e = m_.adj_offset[i]; e < m_.adj_offset[i + 1]; ++e) {
-        const int s = m_.adj_spring[e], j = m_.adj_node[e];
-        f += P::spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), m_.spring_k(s), m_.spring_kd(s), m_.rest_length[s]);
-      }
+      for_each_link(m_, i, [&](int j, float rest, float k, float kd) {
+        f += P::spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), k, kd, rest);
+      });
       const Vec3f ai = P::node_acceleration(sp, i, w, at(xs, i), at(vs, i), f, target);
       a[4 * i] = ai.x;
       a[4 * i + 1] = ai.y;

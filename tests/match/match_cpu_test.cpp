@@ -68,8 +68,7 @@ std::string case_name(const testing::TestParamInfo<Case>& p) {
 Model make_model(const Shape& s) {
   Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny);
   if (s.damped) m.damping = {0.02f, 0.02f, 0.01f};
-  if (s.general) m.topology = Topology::general;
-  return m;
+  return s.general ? explicit_springs(m) : m;
 }
 
 Params make_params(const Shape& s, const Model& m, Integrator i) {

@@ -48,8 +48,9 @@ const std::vector<BadInput>& cases() {
       {"option_not_read", "run --pipeline cpu --option tile=8x8", "--option 'tile' is not an option of cpu"},
       {"option_no_value", "run --option tile", "expected NAME=VALUE"},
       {"unknown_flag", "run --colour red", "--colour"},
-      {"grid_too_large", "run --grid 100000x100000", "GiB of memory"},
-      {"lattice_too_large", "run --lattice 2000x2000x2000", "GiB of memory"},
+      {"grid_too_large", "run --grid 100000x100000", "exceeds the limit of 2^30 nodes"},
+      {"lattice_too_large", "run --lattice 2000x2000x2000", "exceeds the limit of 2^30 nodes"},
+      {"host_memory", "run --pipeline reference --grid 32000x32000", "GiB of host memory"},
       {"out_is_a_file", "run --pipeline cpu --steps 3 --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
       // scene files that are no JSON file
       {"scene_missing", "run --scene {dir}/missing.json", "cannot open scene file"},

@@ -36,6 +36,26 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
 }
 
+// A 4096x4096 cloth (16.8 M nodes) on cpu within memory: the model is its nodes (16 bytes
+// each), the whole run peaks near what the memory check counts (model, the pipeline's 6
+// vectors of floats, one state) and the final state streams into state.ply.
+TEST_F(Cli, LargeClothRunsWithinItsCountedMemory) {
+  const fs::path out = dir_ / "large";
+  const Result r = run("run --pipeline cpu --grid 4096x4096 --steps 2 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
+  const double nodes = 4096.0 * 4096.0;
+  EXPECT_EQ(m["model"]["host_bytes"].get<double>(), 16 * nodes);
+  const auto& mem = m["memory"];
+  const double counted = mem["model_host_bytes"].get<double>() + mem["pipeline_host_bytes"].get<double>() +
+                         mem["state_host_bytes"].get<double>();
+  EXPECT_EQ(counted, (16 + 72 + 36) * nodes);
+  EXPECT_LT(mem["peak_resident_bytes"].get<double>(), counted + (64 << 20)) << "peak resident bytes";
+  std::string head(4096, '\0');
+  std::ifstream(out / "state.ply", std::ios::binary).read(head.data(), std::streamsize(head.size()));
+  EXPECT_EQ(fs::file_size(out / "state.ply"), head.find("end_header\n") + 11 + nodes * 24 + 2 * 4095.0 * 4095.0 * 13);
+}
+
 TEST_F(Cli, PapersAliasesAndLattices) {
   const Result r = run("run --pipeline omp --integrator implicit-euler --lattice 4x3x5 --steps 5 --out " +
                        (dir_ / "lat").string());

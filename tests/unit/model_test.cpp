@@ -1,17 +1,20 @@
-// Builders: spring counts against the closed forms, neighbour counts, rest lengths, CSR.
+// Builders: spring counts against the closed forms, neighbour counts, rest lengths, CSR of
+// the explicit springs, and what a grid model costs on the host.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <set>
 
 #include "core/model.hpp"
+#include "core/springs.hpp"
 
 namespace deformlab {
 namespace {
 
 std::array<std::int64_t, 3> count_kinds(const Model& m) {
   std::array<std::int64_t, 3> c{};
-  for (auto k : m.kind) ++c[int(k)];
+  for_each_spring(m, [&](const SpringRef& s) { ++c[int(s.kind)]; });
   return c;
 }
 
@@ -20,6 +23,7 @@ TEST(Builders, ClothSpringCountsMatchClosedForm) {
     const Model m = cloth_grid(nx, ny, 0.1f, 0.f, Material{});
     EXPECT_EQ(m.node_count(), nx * ny);
     EXPECT_EQ(count_kinds(m), cloth_spring_counts(nx, ny)) << nx << "x" << ny;
+    EXPECT_EQ(count_kinds(explicit_springs(m)), cloth_spring_counts(nx, ny)) << nx << "x" << ny;
   }
   // A hand count for 3x3: 12 structural, 8 shear, 6 flexion.
   EXPECT_EQ(cloth_spring_counts(3, 3), (std::array<std::int64_t, 3>{12, 8, 6}));
@@ -30,19 +34,20 @@ TEST(Builders, LatticeSpringCountsMatchClosedForm) {
     const Model m = lattice(nx, ny, nz, 0.1f, 0.f, Material{});
     EXPECT_EQ(m.node_count(), nx * ny * nz);
     EXPECT_EQ(count_kinds(m), lattice_spring_counts(nx, ny, nz)) << nx << "x" << ny << "x" << nz;
+    EXPECT_EQ(explicit_springs(m).spring_count(), m.spring_count());
   }
   // A 2x2x2 cube: 12 edges, 12 face diagonals + 4 body diagonals, no flexion.
   EXPECT_EQ(lattice_spring_counts(2, 2, 2), (std::array<std::int64_t, 3>{12, 16, 0}));
 }
 
 TEST(Builders, InteriorNodesHaveThePapersNeighbours) {
-  const Model c = cloth_grid(7, 7, 0.1f, 0.f, Material{});
+  const Model c = explicit_springs(cloth_grid(7, 7, 0.1f, 0.f, Material{}));
   const int centre = 3 * 7 + 3;
   std::array<int, 3> per_kind{};
   for (int e = c.adj_offset[centre]; e < c.adj_offset[centre + 1]; ++e) ++per_kind[int(c.kind[c.adj_spring[e]])];
   EXPECT_EQ(per_kind, (std::array<int, 3>{4, 4, 4}));
 
-  const Model l = lattice(5, 5, 5, 0.1f, 0.f, Material{});
+  const Model l = explicit_springs(lattice(5, 5, 5, 0.1f, 0.f, Material{}));
   const int mid = (2 * 5 + 2) * 5 + 2;
   per_kind = {};
   for (int e = l.adj_offset[mid]; e < l.adj_offset[mid + 1]; ++e) ++per_kind[int(l.kind[l.adj_spring[e]])];
@@ -51,7 +56,7 @@ TEST(Builders, InteriorNodesHaveThePapersNeighbours) {
 
 TEST(Builders, RestLengthsAndAdjacencyAreConsistent) {
   const float h = 0.25f;
-  const Model m = lattice(4, 3, 5, h, 1.f, Material{});
+  const Model m = explicit_springs(lattice(4, 3, 5, h, 1.f, Material{}));
   for (int s = 0; s < m.spring_count(); ++s) {
     const float len = norm(m.rest_position[m.spring_i[s]] - m.rest_position[m.spring_j[s]]);
     EXPECT_NEAR(m.rest_length[s], len, 1e-6f);  // the rest state is (to rounding) unstressed
@@ -71,6 +76,34 @@ TEST(Builders, RestLengthsAndAdjacencyAreConsistent) {
       EXPECT_TRUE((m.spring_i[s] == v && m.spring_j[s] == m.adj_node[e]) ||
                   (m.spring_j[s] == v && m.spring_i[s] == m.adj_node[e]));
     }
+}
+
+// A grid is its stencil: no spring arrays, no adjacency; its host bytes are the rest
+// positions and inverse masses (kGridBytesPerNode), as counted before it is built.
+TEST(Builders, GridModelsCostOnlyTheirNodes) {
+  for (const Model& m : {cloth_grid(300, 200, 0.1f, 0.f, Material{}), lattice(20, 30, 40, 0.1f, 0.f, Material{})}) {
+    EXPECT_TRUE(m.spring_i.empty() && m.rest_length.empty() && m.kind.empty() && m.adj_offset.empty());
+    EXPECT_EQ(m.host_bytes(), kGridBytesPerNode * m.node_count());
+    EXPECT_EQ(model_host_bytes(m.size()), m.host_bytes());
+    const Model g = explicit_springs(m);  // the same springs spelled out: about 20x the bytes
+    EXPECT_GE(model_host_bytes(g.size()), g.host_bytes());
+    EXPECT_GT(g.host_bytes(), 10 * m.host_bytes());
+  }
+}
+
+// Resident memory grows by the model's bytes and no more when a 2048x2048 cloth is built.
+TEST(Builders, BuildingAGridTouchesOnlyItsNodes) {
+  auto resident = [] {
+    std::ifstream in("/proc/self/statm");
+    std::int64_t size = 0, pages = 0;
+    in >> size >> pages;
+    return pages * 4096;
+  };
+  const std::int64_t before = resident();
+  const Model m = cloth_grid(2048, 2048, 0.001f, 0.f, Material{});
+  const double per_node = double(resident() - before) / m.node_count();
+  EXPECT_LE(per_node, kGridBytesPerNode + 0.5) << "bytes per node";
+  EXPECT_GE(per_node, kGridBytesPerNode - 0.5) << "bytes per node";  // the arrays are filled
 }
 
 TEST(Builders, PinSets) {

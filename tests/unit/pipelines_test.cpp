@@ -22,5 +22,30 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_EQ(r.find("hybrid")->options, (std::vector<std::string>{"interop", "force", "tile"}));
 }
 
+// The check before a run adds the model, the pipeline's own host bytes and a state, and names
+// the limit that refuses it; grids cost the same whatever their spring count.
+TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {
+  const PipelineRegistry& r = pipelines();
+  const PipelineEntry& cpu = *r.find("cpu");
+  const ModelSize small{128 * 128, 6 * 128 * 128, true};
+  EXPECT_EQ(host_memory_shortfall(small, cpu, Integrator::semi_implicit_euler, {}), "");
+  const auto limit = host_memory_limit();
+  ASSERT_TRUE(limit.has_value());
+  EXPECT_GT(limit->bytes, 0);
+  // Semi-implicit Euler on cpu: slots (x, v), one acceleration, next (x, v), x_prev: 6 vec3 of floats.
+  EXPECT_EQ(cpu.footprint(small, Integrator::semi_implicit_euler, {}).host, small.nodes * 6 * 12);
+  const ModelSize big{std::int64_t(1) << 30, 6 * (std::int64_t(1) << 30), true};
+  const std::string why = host_memory_shortfall(big, cpu, Integrator::semi_implicit_euler, {});
+  EXPECT_NE(why.find("needs 124 GiB of host memory (model 16 GiB, pipeline 72 GiB, state 36 GiB)"), std::string::npos)
+      << why;
+  EXPECT_NE(why.find(limit->name + " leaves"), std::string::npos) << why;
+  EXPECT_NE(host_memory_shortfall({(std::int64_t(1) << 30) + 1, 0, true}, cpu, Integrator::verlet, {})
+                .find("exceeds the limit of 2^30 nodes"),
+            std::string::npos);
+  // With --compare, the reference pipeline (doubles) and its state are counted too.
+  const std::string both = host_memory_shortfall(big, cpu, Integrator::semi_implicit_euler, {}, r.find("reference"));
+  EXPECT_NE(both.find("reference pipeline and state 180 GiB"), std::string::npos) << both;
+}
+
 }  // namespace
 }  // namespace deformlab

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "core/cpu_backend.hpp"
+#include "core/springs.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab {
@@ -49,13 +50,16 @@ TEST(GridStencil, EveryNeighbourOnceIncomingThenOwn) {
   }
 }
 
-// Each node's stencil neighbours inside the grid are its adjacency list, spring for spring
-// (kind and rest length), and in the same order once the grid is at least 5 nodes wide.
+// Each node's stencil neighbours inside the grid (and for_each_link's) are the adjacency of
+// the grid's explicit springs (each node's own stencil half), spring for spring (kind and
+// rest length), and in the same order once the grid is at least 5 nodes wide.
 TEST(GridStencil, BuildersSpringsAreTheStencilsInBoundsPairs) {
   const std::vector<Model> models = {test::small_cloth(1, 1), test::small_cloth(2, 3), test::small_cloth(5, 4),
                                      test::small_cloth(37, 53), test::small_lattice(2, 3, 4),
                                      test::small_lattice(5, 6, 5)};
   for (const Model& m : models) {
+    const Model g = explicit_springs(m);
+    ASSERT_EQ(g.spring_count(), m.spring_count());
     const bool wide = m.nx >= 5 && m.ny >= 5 && (!m.volume() || m.nz >= 5);
     for (int v = 0; v < m.node_count(); ++v) {
       const int i = v % m.nx, j = (v / m.nx) % m.ny, k = v / (m.nx * m.ny);
@@ -66,9 +70,15 @@ TEST(GridStencil, BuildersSpringsAreTheStencilsInBoundsPairs) {
         if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
         by_stencil.emplace_back((c * m.ny + b) * m.nx + a, o.kind, grid_rest_length(m, o));
       }
-      for (int e = m.adj_offset[v]; e < m.adj_offset[v + 1]; ++e) {
-        const int s = m.adj_spring[e];
-        by_springs.emplace_back(m.adj_node[e], int(m.kind[s]), m.rest_length[s]);
+      std::vector<std::tuple<int, float, float>> by_links;  // other node, rest length, k
+      for_each_link(m, v, [&](int w, float rest, float k, float) { by_links.emplace_back(w, rest, k); });
+      ASSERT_EQ(by_links.size(), by_stencil.size());
+      for (std::size_t q = 0; q < by_links.size(); ++q)
+        EXPECT_EQ(by_links[q], std::tuple(std::get<0>(by_stencil[q]), std::get<2>(by_stencil[q]),
+                                          m.stiffness[std::get<1>(by_stencil[q])]));
+      for (int e = g.adj_offset[v]; e < g.adj_offset[v + 1]; ++e) {
+        const int s = g.adj_spring[e];
+        by_springs.emplace_back(g.adj_node[e], int(g.kind[s]), g.rest_length[s]);
       }
       if (!wide) {
         std::sort(by_stencil.begin(), by_stencil.end());
@@ -85,8 +95,7 @@ TEST(GridStencil, StencilAndAdjacencyPathsAgree) {
   for (auto [m, bitwise] : {std::pair{test::small_cloth(37, 53), true}, {test::small_lattice(6, 5, 7), true},
                             {test::small_cloth(3, 4), false}, {test::small_lattice(2, 3, 4), false}}) {
     m.damping = {0.02f, 0.02f, 0.01f};
-    Model general = m;
-    general.topology = Topology::general;
+    const Model general = explicit_springs(m);
     const Params p = test::small_params();
     const State s0 = test::perturbed_state(m, 3);
     auto grid = make_cpu_pipeline({m, p, Integrator::rk4}, Precision::f32, false);
@@ -105,8 +114,7 @@ TEST(GridStencil, StencilAndAdjacencyPathsAgree) {
 // Per-spring constants replace the per-kind ones: equal values give the same state; a stiffer
 // spring changes the motion of its ends.
 TEST(GridStencil, PerSpringConstantsOfGeneralModels) {
-  Model m = test::small_cloth(8, 8);
-  m.topology = Topology::general;
+  Model m = explicit_springs(test::small_cloth(8, 8));
   m.damping = {0.02f, 0.02f, 0.01f};
   Model per_spring = m;
   for (int e = 0; e < m.spring_count(); ++e) {

@@ -1,0 +1,62 @@
+// The springs of a model, whichever its shape: grids by their stencil, general models by
+// their spring lists and adjacency. Stages that need springs one by one (the implicit solve,
+// energies, the stability bound, scatter) walk them here; the gather kernels read the
+// stencil or the adjacency directly, which is their fast path.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+
+#include "model.hpp"
+
+namespace deformlab {
+
+struct SpringRef {
+  int i, j;  // end nodes, i < j
+  float rest, k, kd;
+  SpringKind kind;
+};
+
+// f(SpringRef) for every spring once. Grids: node by node, each node's own stencil half.
+template <class F>
+void for_each_spring(const Model& m, F&& f) {
+  if (!m.grid()) {
+    for (std::int64_t e = 0; e < m.spring_count(); ++e)
+      f(SpringRef{m.spring_i[e], m.spring_j[e], m.rest_length[e], m.spring_k(int(e)), m.spring_kd(int(e)),
+                  m.kind[e]});
+    return;
+  }
+  const int size = grid_stencil_size(m.volume());
+  for (int k = 0; k < m.nz; ++k)
+    for (int j = 0; j < m.ny; ++j)
+      for (int i = 0; i < m.nx; ++i)
+        for (int e = size / 2; e < size; ++e) {
+          const GridOffset o = grid_offset(m.volume(), e);
+          const int a = i + o.di, b = j + o.dj, c = k + o.dk;
+          if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
+          const int u = (k * m.ny + j) * m.nx + i, v = (c * m.ny + b) * m.nx + a;
+          f(SpringRef{std::min(u, v), std::max(u, v), grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind],
+                      SpringKind(o.kind)});
+        }
+}
+
+// f(other node, rest, k, kd) for every spring of node v: grids in stencil order, general
+// models in adjacency order.
+template <class F>
+void for_each_link(const Model& m, int v, F&& f) {
+  if (!m.grid()) {
+    for (int e = m.adj_offset[v]; e < m.adj_offset[v + 1]; ++e) {
+      const int s = m.adj_spring[e];
+      f(m.adj_node[e], m.rest_length[s], m.spring_k(s), m.spring_kd(s));
+    }
+    return;
+  }
+  const int i = v % m.nx, j = (v / m.nx) % m.ny, k = v / (m.nx * m.ny);
+  for (int e = 0; e < grid_stencil_size(m.volume()); ++e) {
+    const GridOffset o = grid_offset(m.volume(), e);
+    const int a = i + o.di, b = j + o.dj, c = k + o.dk;
+    if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
+    f((c * m.ny + b) * m.nx + a, grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind]);
+  }
+}
+
+}  // namespace deformlab
