@@ -1,6 +1,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -97,7 +98,7 @@ json memory_of(const RunInput& in) {
 }
 
 json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, const Ran& ran, const Profiler& profiler,
-                 double median_ms) {
+                 double median_ms, double setup_s) {
   const RunResult& r = ran.result;
   json manifest = {
       {"command", a.argv},
@@ -112,6 +113,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
                  {"stability_limit_s", stability_limit(in.model, in.params, in.integ)},
                  {"host_bytes", in.model.host_bytes()}}},
       {"memory", memory_of(in)},
+      {"setup", {{"model_build_s", in.build_s}, {"pipeline_setup_s", setup_s}, {"clock", "host steady_clock"}}},
       {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * double(in.params.dt)},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"median_step_ms_host_clock", median_ms}, {"stage_timing", pipe.timing_method()}}},
@@ -128,7 +130,8 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
 }
 
 void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, const RunResult& r,
-                   const Profiler& profiler, double median_ms, const json& compare, const OutputDir& dir) {
+                   const Profiler& profiler, double median_ms, const json& compare, const OutputDir& dir,
+                   double setup_s) {
   const Model& m = in.model;
   const bool lattice = m.topology == Topology::lattice;
   std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name) << " on " << in.entry->name << " ("
@@ -154,12 +157,14 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
               << " ms  (" << g.clock << ")\n";
   const json mem = memory_of(in);
   const double nodes = double(m.node_count());
-  std::cout << "  memory: host " << gib(mem["peak_resident_bytes"]) << " at peak ("
-            << mem["peak_resident_bytes"].get<double>() / nodes << " bytes/node; the model "
-            << mem["model_host_bytes"].get<double>() / nodes << ")";
+  std::cout << "  setup: model built in " << in.build_s << " s, pipeline in " << setup_s << " s (host clock)\n";
+  std::cout << "  memory: host " << gib(mem["peak_resident_bytes"]) << " resident at peak; counted per node: model "
+            << mem["model_host_bytes"].get<double>() / nodes << " B, pipeline "
+            << mem["pipeline_host_bytes"].get<double>() / nodes << " B, state "
+            << mem["state_host_bytes"].get<double>() / nodes << " B";
   if (mem["pipeline_device_bytes"].get<std::int64_t>() > 0)
-    std::cout << ", device " << gib(mem["pipeline_device_bytes"]) << " ("
-              << mem["pipeline_device_bytes"].get<double>() / nodes << " bytes/node)";
+    std::cout << "; device " << mem["pipeline_device_bytes"].get<double>() / nodes << " B ("
+              << gib(mem["pipeline_device_bytes"]) << ")";
   std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
             << "manifest.json" << (a.trace ? ", trace.json" : "") << "}\n";
 }
@@ -172,7 +177,9 @@ int run_command(const RunArgs& a) {
     const RunInput in = read_run_input(a);
     // 2. Run, writing into a staging folder that is committed only on success.
     OutputDir dir(a.out ? *a.out : "runs/" + (in.x.name.empty() ? std::string("run") : in.x.name));
+    const auto t0 = std::chrono::steady_clock::now();
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
+    const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     Profiler profiler;
     const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);
     const RunResult& r = ran.result;
@@ -186,14 +193,14 @@ int run_command(const RunArgs& a) {
     profiler.write_csv(dir.staged("spans.csv").string());
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
     if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
-    json manifest = manifest_of(a, in, *pipe, ran, profiler, med);
+    json manifest = manifest_of(a, in, *pipe, ran, profiler, med, setup_s);
     if (a.compare) manifest["compare"] = compare;
 #if DEFORMLAB_GL_RENDER
     if (auto g = gl::run_manifest(*pipe); !g.is_null()) manifest["gl"] = g;
 #endif
     write_json(dir.staged("manifest.json"), manifest);
     dir.commit();
-    print_summary(a, in, *pipe, r, profiler, med, compare, dir);
+    print_summary(a, in, *pipe, r, profiler, med, compare, dir, setup_s);
     return 0;
   });
 }

@@ -1,6 +1,7 @@
 #include "run_input.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -122,7 +123,9 @@ RunInput read_run_input(const RunArgs& a) {
   if (a.compare && *a.compare != "cpu")
     throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
   check_fits(in, bool(a.compare));
+  const auto t0 = std::chrono::steady_clock::now();
   in.model = build_model(in.x.scene);
+  in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);
   return in;
 }

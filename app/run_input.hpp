@@ -16,6 +16,7 @@ struct RunInput {
   bool until_converged = false;
   Model model;
   Params params;
+  double build_s = 0.0;  // building the model, host clock
 };
 
 // Reads the experiment or scene, applies the flags and builds the model; bad input

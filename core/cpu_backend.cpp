@@ -42,6 +42,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     for (auto& sl : slots_) { sl.x.resize(n); sl.v.resize(n); }
     acc_.resize(sched_.accel_slots, std::vector<V>(n));
     next_.x.resize(n); next_.v.resize(n);
+    x_prev_.resize(n);
     set_state(rest_state(m_));
   }
 
@@ -49,14 +50,12 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     const std::size_t n = m_.rest_position.size();
     if (s.x.size() != n || s.v.size() != n || (!s.x_prev.empty() && s.x_prev.size() != n))
       throw std::invalid_argument("state size does not match the model");
-    for (std::size_t i = 0; i < n; ++i) {
+    has_prev_ = !s.x_prev.empty();
+    for_nodes([&](int i) {
       slots_[0].x[i] = V(s.x[i]);
       slots_[0].v[i] = V(s.v[i]);
-    }
-    has_prev_ = !s.x_prev.empty();
-    x_prev_.resize(n);
-    if (has_prev_)
-      for (std::size_t i = 0; i < n; ++i) x_prev_[i] = V(s.x_prev[i]);
+      if (has_prev_) x_prev_[i] = V(s.x_prev[i]);
+    });
     t_ = s.t;
     last_disp_ = 0.0;
   }
@@ -66,11 +65,12 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     s.t = t_;
     const std::size_t n = slots_[0].x.size();
     s.x.resize(n); s.v.resize(n);
-    for (std::size_t i = 0; i < n; ++i) { s.x[i] = Vec3f(slots_[0].x[i]); s.v[i] = Vec3f(slots_[0].v[i]); }
-    if (has_prev_) {
-      s.x_prev.resize(n);
-      for (std::size_t i = 0; i < n; ++i) s.x_prev[i] = Vec3f(x_prev_[i]);
-    }
+    if (has_prev_) s.x_prev.resize(n);
+    for_nodes([&](int i) {
+      s.x[i] = Vec3f(slots_[0].x[i]);
+      s.v[i] = Vec3f(slots_[0].v[i]);
+      if (has_prev_) s.x_prev[i] = Vec3f(x_prev_[i]);
+    });
     return s;
   }
 

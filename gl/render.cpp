@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <numeric>
 #include <stdexcept>
 
 #include "gl_pipeline.hpp"
@@ -57,9 +58,16 @@ struct Renderer::Impl {
   Renderbuffer color, depth;
   Program prog;
   VertexArray vao;
-  Buffer upload, indices;
+  Buffer upload;
   Texture draw_tex;
-  GLsizei index_count = 0;
+  // What one draw call covers: the texture range over the positions it reads (from node
+  // tex_first, tex_count nodes) and its points or quad rows.
+  struct Band {
+    std::int64_t tex_first, tex_count;
+    int first, count;  // points: nodes; surface: quad rows of the sampled grid
+  };
+  std::vector<Band> bands;
+  int stride = 1;  // surface: every stride-th row and column (a frame shows no more)
   Mat4 view_proj{};
   Vec3f eye;
   Timer timer;
@@ -92,20 +100,11 @@ struct Renderer::Impl {
     prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
     glGenVertexArrays(1, &id);
     vao = VertexArray(id);
-    if (surface) {
-      std::vector<std::uint32_t> idx;
-      idx.reserve(std::size_t(m.nx - 1) * (m.ny - 1) * 6);
-      for (int j = 0; j + 1 < m.ny; ++j)
-        for (int i = 0; i + 1 < m.nx; ++i) {
-          const std::uint32_t a = std::uint32_t(j * m.nx + i), b = a + 1, c = a + std::uint32_t(m.nx), d = c + 1;
-          idx.insert(idx.end(), {a, c, b, b, c, d});
-        }
-      index_count = GLsizei(idx.size());
-      indices = make_buffer(idx.size() * 4, idx.data());
-      glBindVertexArray(vao.id());
-      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indices.id());
-      glBindVertexArray(0);
-    }
+    GLint texels = 0, align = 16;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+    glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &align);
+    plan_bands(o.band_texels > 0 ? std::min<std::int64_t>(o.band_texels, texels) : texels,
+               std::lcm(std::max(align, 1), 16) / 16);
     // Camera: in front of and above the rest shape and the space below it where a pinned
     // model hangs, looking at the centre of both.
     Vec3f lo = m.rest_position[0], hi = lo;
@@ -121,11 +120,31 @@ struct Renderer::Impl {
     check("renderer setup");
   }
 
-  void draw_buffer(GLuint positions) {
-    if (!draw_tex || draw_source != positions) {
-      draw_tex = make_texture_buffer(positions, GL_RGBA32F);
-      draw_source = positions;
+  // Splits the drawing into bands whose positions fit in one texture buffer view of at most
+  // `texels` texels starting at a multiple of `align` nodes.
+  void plan_bands(std::int64_t texels, std::int64_t align) {
+    const std::int64_t n = m.node_count();
+    if (!surface) {
+      const std::int64_t per = std::min<std::int64_t>(n, (texels - align) / align * align);
+      for (std::int64_t first = 0; first < n; first += per)
+        bands.push_back({first, std::min(per, n - first), int(first), int(std::min(per, n - first))});
+      return;
     }
+    stride = std::max(1, int(std::max(m.nx, m.ny) / (2 * std::max(o.width, o.height))));
+    const int rows = (m.ny - 2) / stride + 1;  // quad rows of the sampled grid
+    // A band of r quad rows reads node rows from one stride above its first to one below its last.
+    const std::int64_t fit = (texels - align) / m.nx / stride - 3;
+    if (fit < 1) throw std::invalid_argument("cloth rows of " + std::to_string(m.nx) + " nodes are too long to draw");
+    for (int first = 0; first < rows; first += int(fit)) {
+      const int count = int(std::min<std::int64_t>(fit, rows - first));
+      const std::int64_t row0 = std::max(0, (first - 1) * stride);
+      const std::int64_t row1 = std::min<std::int64_t>(m.ny - 1, std::int64_t(first + count + 1) * stride);
+      const std::int64_t tex_first = row0 * m.nx / align * align;
+      bands.push_back({tex_first, (row1 + 1) * m.nx - tex_first, first, count});
+    }
+  }
+
+  void draw_buffer(GLuint positions) {
     timer.begin();
     const GLint previous = bound_framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
@@ -141,13 +160,19 @@ struct Renderer::Impl {
     glUniform1f(uniform(prog.id(), "u_point_size"),
                 std::clamp(float(o.width) / std::sqrt(float(m.node_count())) * 0.4f, 1.f, 8.f));
     glUniform3f(uniform(prog.id(), "u_eye"), eye.x, eye.y, eye.z);
+    glUniform1i(uniform(prog.id(), "u_stride"), stride);
+    if (!draw_tex) draw_tex = make_texture();
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_BUFFER, draw_tex.id());
     glBindVertexArray(vao.id());
-    if (surface)
-      glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
-    else
-      glDrawArrays(GL_POINTS, 0, m.node_count());
+    const int quads_per_row = (m.nx - 2) / stride + 1;
+    for (const Band& b : bands) {
+      glTexBufferRange(GL_TEXTURE_BUFFER, GL_RGBA32F, positions, GLintptr(b.tex_first * 16), GLsizeiptr(b.tex_count * 16));
+      glUniform1i(uniform(prog.id(), "u_first"), b.first);
+      glUniform1i(uniform(prog.id(), "u_tex_first"), int(b.tex_first));
+      if (surface) glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * std::int64_t(quads_per_row) * b.count));
+      else glDrawArrays(GL_POINTS, 0, b.count);
+    }
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
@@ -156,7 +181,11 @@ struct Renderer::Impl {
     check("rendering a frame");
   }
 
-  GLuint draw_source = 0;
+  static Texture make_texture() {
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    return Texture(id);
+  }
 };
 
 Renderer::Renderer(const Model& m, RenderOptions o) {
@@ -179,19 +208,18 @@ void Renderer::draw(const State& s) {
   Impl& r = *impl_;
   const std::size_t n = std::size_t(r.m.node_count());
   if (s.x.size() != n) throw std::invalid_argument("state size does not match the model");
-  std::vector<float> data(4 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    data[4 * i] = s.x[i].x;
-    data[4 * i + 1] = s.x[i].y;
-    data[4 * i + 2] = s.x[i].z;
-    data[4 * i + 3] = r.m.inv_mass[i];
-  }
-  if (!r.upload) {
-    r.upload = make_buffer(data.size() * 4, data.data());
-  } else {
-    glBindBuffer(GL_ARRAY_BUFFER, r.upload.id());
-    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(data.size() * 4), data.data());
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
+  if (!r.upload) r.upload = make_buffer(n * 16);
+  // A chunk at a time: no second host copy of the positions.
+  std::vector<float> data(4 * std::min<std::size_t>(n, kTransferChunkNodes));
+  for (std::size_t base = 0; base < n; base += kTransferChunkNodes) {
+    const std::size_t count = std::min<std::size_t>(kTransferChunkNodes, n - base);
+    for (std::size_t i = 0; i < count; ++i) {
+      data[4 * i] = s.x[base + i].x;
+      data[4 * i + 1] = s.x[base + i].y;
+      data[4 * i + 2] = s.x[base + i].z;
+      data[4 * i + 3] = r.m.inv_mass[base + i];
+    }
+    glNamedBufferSubData(r.upload.id(), GLintptr(base * 16), GLsizeiptr(count * 16), data.data());
   }
   r.draw_buffer(r.upload.id());
 }

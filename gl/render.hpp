@@ -18,6 +18,10 @@ namespace deformlab::gl {
 struct RenderOptions {
   int width = 1024, height = 1024;  // the paper's output size
   enum class Mode { automatic, points, surface } mode = Mode::automatic;  // automatic: surface for cloth grids
+  // Texels of position data one draw call reads (0: the driver's texture buffer limit); a
+  // larger model is drawn in bands. A cloth wider than twice the frame is drawn every
+  // stride-th row and column.
+  std::int64_t band_texels = 0;
 };
 
 class Renderer {

@@ -69,6 +69,26 @@ TEST(GlRender, ClothSurfaceFromEveryKindOfPipeline) {
   EXPECT_EQ(r.take_draw_ms().size(), 3u);
 }
 
+// A model drawn in bands (each draw reading a few rows of positions, as the largest models
+// are past the texture buffer limit) gives the pixels of one draw; a cloth wider than twice
+// the frame is drawn every stride-th row and column, still framed.
+TEST(GlRender, BandsAndStridesDrawTheSameModel) {
+  DEFORMLAB_REQUIRE_GL();
+  for (const Model& m : {small_cloth(40, 33), small_lattice(9, 8, 7)}) {
+    const State s = perturbed_state(m, 3, 0.01f, 0.f);
+    gl::Renderer whole(m, {200, 200}), banded(m, {200, 200, gl::RenderOptions::Mode::automatic, 8 * m.nx});
+    whole.draw(s);
+    banded.draw(s);
+    const auto a = whole.pixels(), b = banded.pixels();
+    EXPECT_EQ(a, b) << m.nx << "x" << m.ny << "x" << m.nz;
+    expect_centred(coverage(a, 200, 200), 200, 200, 0.02, "whole");
+  }
+  const Model wide = small_cloth(700, 90);  // 700 > 2 x 128 pixels: every 2nd node drawn
+  gl::Renderer r(wide, {128, 128, gl::RenderOptions::Mode::automatic, 20 * 700});
+  r.draw(rest_state(wide));
+  expect_centred(coverage(r.pixels(), 128, 128), 128, 128, 0.015, "a 700x90 cloth drawn every 2nd node");
+}
+
 TEST(GlRender, LatticeAsPointsAndPngFile) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_lattice(6, 5, 4);
