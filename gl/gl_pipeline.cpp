@@ -279,11 +279,16 @@ State GlPipeline::state() {
   const std::size_t n = std::size_t(n_);
   const int chunk = std::min(kTransferChunkNodes, n_);
   std::vector<float> data(4 * std::size_t(chunk));
+  // Each chunk is copied into a staging buffer on the GPU and read from there: a driver may
+  // keep a host copy of whatever buffer is read back, which is then chunk-sized.
+  const Buffer staging = make_buffer(std::size_t(chunk) * 16);
   auto download = [&](const NodeBuffer& b, std::vector<Vec3f>& out) {
     out.resize(n);
     for (int base = 0; base < n_; base += chunk) {
       const int count = std::min(chunk, n_ - base);
-      read_buffer(b.id(), std::size_t(base) * 16, std::size_t(count) * 16, data.data());
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      glCopyNamedBufferSubData(b.id(), staging.id(), GLintptr(base) * 16, 0, GLsizeiptr(count) * 16);
+      read_buffer(staging.id(), 0, std::size_t(count) * 16, data.data());
       for (int i = 0; i < count; ++i)
         out[std::size_t(base + i)] = {data[4 * std::size_t(i)], data[4 * std::size_t(i) + 1], data[4 * std::size_t(i) + 2]};
     }

@@ -61,7 +61,8 @@ if part experiments; then
 fi
 
 # The largest grids: 20 steps with the stop rule checked every step (state.ply left out: 13 GB
-# at 16384^2), device memory sampled by nvidia-smi; then --compare cpu at 1024^2 and 96^3.
+# at 16384^2), device memory sampled by nvidia-smi, a frame of a 16384^2 cloth drawn from GL
+# buffers and from a CUDA state; then --compare cpu at 1024^2 and 96^3.
 scale_run() {  # name, then run arguments
   local name=$1; shift
   nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits -lms 100 >"$out/scale-$name.gpumem" 2>/dev/null &
@@ -70,6 +71,7 @@ scale_run() {  # name, then run arguments
   local rc=$?
   kill "$smi" 2>/dev/null
   cp "/tmp/scale-$name/manifest.json" "$out/scale-$name.json" 2>/dev/null
+  for f in /tmp/scale-$name/frames/*.png; do [ -f "$f" ] && cp "$f" "$out/scale-$name-$(basename "$f")"; done
   rm -rf "/tmp/scale-$name"
   local peak=$(sort -n "$out/scale-$name.gpumem" | tail -1)
   summary+=("scale $name (rc $rc, GPU peak ${peak} MiB): $(grep -E 'median|memory:|error|refused|limit' "$out/scale-$name.log" | tr -s ' ' | tr '\n' ' ')")
@@ -82,6 +84,8 @@ if part scale; then
   scale_run glsl-tf-cloth11585 --pipeline glsl-tf --grid 11585x11585
   scale_run glsl-tf-lattice512 --pipeline glsl-tf --lattice 512x512x512
   scale_run glsl-tf-cloth16384 --pipeline glsl-tf --grid 16384x16384
+  scale_run glsl-compute-frames16384 --pipeline glsl-compute --grid 16384x16384 --frames 20
+  scale_run cuda-fused-frames16384 --pipeline cuda-fused --grid 16384x16384 --frames 20
   for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
     scale_run "$p-compare1024" --pipeline "$p" --grid 1024x1024 --compare cpu
     scale_run "$p-compare96" --pipeline "$p" --lattice 96x96x96 --compare cpu
