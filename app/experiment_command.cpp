@@ -32,6 +32,7 @@ int experiment_command(const ExperimentArgs& a) {
   nlohmann::json calibration;
   try {
     require_folder_or_nothing(dir);
+    if (!a.report_only) require_same_experiment(dir, x.name);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << e.what() << "\n";

@@ -1,7 +1,11 @@
 #include "output.hpp"
 
 #include <sys/utsname.h>
+#include <signal.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 
 #include <Eigen/Core>
 #include <fstream>
@@ -21,14 +25,31 @@ void require_folder_or_nothing(const fs::path& dir) {
     throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
 }
 
+fs::path temporary(const fs::path& name) { return name.string() + ".tmp-" + std::to_string(::getpid()); }
+
+void reclaim_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    std::size_t at = name.rfind(".tmp-");
+    std::size_t len = 5;
+    if (name.rfind(".staging-", 0) == 0) at = 0, len = 9;
+    if (at == std::string::npos) continue;
+    const std::string digits = name.substr(at + len);
+    if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
+    const pid_t pid = pid_t(std::stol(digits));
+    if (pid == ::getpid() || (::kill(pid, 0) == -1 && errno == ESRCH)) fs::remove_all(e.path(), ec);
+  }
+}
+
 OutputDir::OutputDir(const fs::path& dir) : dir_(dir) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
   created_ = !fs::exists(dir_, ec);
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
+  reclaim_temporaries(dir_);
   staging_ = dir_ / (".staging-" + std::to_string(::getpid()));
-  fs::remove_all(staging_, ec);
   fs::create_directory(staging_, ec);
   if (ec) throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
 }
@@ -40,11 +61,14 @@ OutputDir::~OutputDir() {
 }
 
 void OutputDir::commit() {
+  fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
   for (const auto& e : fs::directory_iterator(staging_)) {
+    if (e.path().filename() == "manifest.json") continue;
     const fs::path target = dir_ / e.path().filename();
     if (fs::is_directory(e.path()) && fs::exists(target)) fs::remove_all(target);
     fs::rename(e.path(), target);
   }
+  if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
 }
 
 void write_ply(const fs::path& file, const Model& m, const State& s) {

@@ -1,5 +1,7 @@
 // Run outputs. Files are written into a staging folder inside the output folder and moved
-// into place only when the whole run succeeded, so a failed run leaves the folder as it was.
+// into place only when the whole run succeeded, so a failed run leaves the folder as it was;
+// manifest.json goes first out and last in, so a folder whose outputs are complete is one
+// with a manifest. Temporaries of killed processes are reclaimed by the next one.
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -15,6 +17,11 @@ namespace deformlab {
 // Throws std::invalid_argument when `dir` exists and is not a folder.
 void require_folder_or_nothing(const std::filesystem::path& dir);
 
+// The temporary name of `name` for this process: "<name>.tmp-<pid>".
+std::filesystem::path temporary(const std::filesystem::path& name);
+// Removes the temporaries in `dir` ("*.tmp-<pid>", ".staging-<pid>") whose process is gone.
+void reclaim_temporaries(const std::filesystem::path& dir);
+
 class OutputDir {
  public:
   // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder).
@@ -27,7 +34,8 @@ class OutputDir {
 
   // Where to write a file or folder named `name` before commit().
   std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
-  // Moves every staged entry into the output folder (replacing entries of the same name).
+  // Moves every staged entry into the output folder (replacing entries of the same name):
+  // the old manifest.json is removed first and the new one moved in last.
   void commit();
   const std::filesystem::path& dir() const { return dir_; }
 

@@ -140,7 +140,7 @@ std::vector<Cell> cells(const Sweep& s) {
 json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 #if DEFORMLAB_HAVE_GL
   if (auto why = gl::unavailable_reason(); !why.empty()) return {{"unavailable", "no OpenGL: " + why}};
-  const fs::path tmp = dir / ("frames.tmp-" + std::to_string(::getpid()));
+  const fs::path tmp = temporary(dir / "frames");
   try {
     const Model m = build_model(x.scene);
     Params p = resolve_params(x.scene, m);
@@ -184,7 +184,7 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 }
 
 void write_atomically(const fs::path& file, const std::string& text) {
-  const fs::path tmp = file.string() + ".tmp-" + std::to_string(::getpid());
+  const fs::path tmp = temporary(file);
   std::ofstream out(tmp);
   out << text;
   out.close();
@@ -199,6 +199,18 @@ json read_manifest(const fs::path& dir) {
   return j.is_discarded() ? json(nullptr) : j;
 }
 
+namespace {
+
+// A cell file's result, or null when the file is not a cell result (damaged, edited).
+json read_cell(const fs::path& file) {
+  std::ifstream in(file);
+  json j = json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("status") || !j.contains("id")) return nullptr;
+  return j;
+}
+
+}  // namespace
+
 std::vector<json> load_cells(const fs::path& dir) {
   std::vector<json> out;
   if (!fs::is_directory(dir / "cells")) return out;
@@ -207,15 +219,30 @@ std::vector<json> load_cells(const fs::path& dir) {
     if (f.path().extension() == ".json") files.push_back(f.path());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
-    std::ifstream in(f);
-    out.push_back(json::parse(in));
+    json j = read_cell(f);
+    if (j.is_null())
+      throw std::invalid_argument("cell file " + f.string() + " is not a cell result (run the experiment again to redo it)");
+    out.push_back(std::move(j));
   }
   return out;
 }
 
+void require_same_experiment(const fs::path& dir, const std::string& name) {
+  const json old = read_manifest(dir);
+  const json was = old.is_object() && old.contains("experiment") && old["experiment"].is_object()
+                       ? old["experiment"].value("name", json())
+                       : json();
+  if (was.is_string() && was.get<std::string>() != name)
+    throw std::invalid_argument("results folder " + dir.string() + " holds experiment '" + was.get<std::string>() +
+                                "', not '" + name + "': give this one another --out");
+}
+
 int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
   using clock = std::chrono::steady_clock;
+  require_same_experiment(dir, x.name);
   fs::create_directories(dir / "cells");
+  reclaim_temporaries(dir);
+  reclaim_temporaries(dir / "cells");
   json manifest = {{"experiment", x.raw}, {"command", command}, {"build", build_info()}, {"machine", machine_info()}};
   // The calibration given, else the one an earlier run of this folder recorded; the frames
   // an earlier run rendered.
@@ -224,6 +251,8 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     if (old.contains("calibration") && o.calibration.is_null()) manifest["calibration"] = old["calibration"];
     if (old.contains("frames") && fs::exists(dir / "frames")) manifest["frames"] = old["frames"];
   }
+  // Frames that no manifest records come from a run killed in between: render them again.
+  if (!manifest.contains("frames")) fs::remove_all(dir / "frames");
   json devices = json::object();
   for (const auto& p : s.pipelines)
     if (const auto* e = pipelines().find(p)) devices[p] = e->unavailable().empty() ? "available" : e->unavailable();
@@ -239,11 +268,7 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   for (const auto& c : all) {
     const fs::path file = dir / "cells" / (c.id() + ".json");
     // A measured cell is done; an n/a one is tried again (the build or machine may differ).
-    json r;
-    if (fs::exists(file)) {
-      std::ifstream in(file);
-      r = json::parse(in);
-    }
+    json r = fs::exists(file) ? read_cell(file) : json();  // a damaged cell file is redone
     if (r.is_object() && r["status"] == "ok") {
       ++prog.skipped;
     } else {

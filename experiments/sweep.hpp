@@ -80,6 +80,8 @@ std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);
 
 // `dir`/manifest.json, or null when there is none or it is not JSON.
 nlohmann::json read_manifest(const std::filesystem::path& dir);
+// Throws std::invalid_argument when `dir` holds the results of another experiment than `name`.
+void require_same_experiment(const std::filesystem::path& dir, const std::string& name);
 
 // Writes `text` to `file` through a temporary file and a rename.
 void write_atomically(const std::filesystem::path& file, const std::string& text);
