@@ -3,8 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments scale" to run, default all
-# but scale),
+# Environment: PARTS (which of "tests sanitizers bench experiments scale endurance" to run,
+# default all but scale and endurance),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
@@ -89,6 +89,38 @@ if part scale; then
   for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
     scale_run "$p-compare1024" --pipeline "$p" --grid 1024x1024 --compare cpu
     scale_run "$p-compare96" --pipeline "$p" --lattice 96x96x96 --compare cpu
+  done
+fi
+
+# 1 M steps of a 1024^2 cloth on cuda-fused (stop rule every 1000 steps): host resident memory
+# and GPU memory sampled each second, ms per step per 100 k-step window (host clock over the
+# window, which the checks drain); then cuda-scatter's spread: the same 200 steps three times,
+# the largest difference between the final states' values.
+ply_floats() {  # the vertex values of a state.ply, one per line
+  local off n
+  off=$(grep -abo end_header "$1" | head -1 | cut -d: -f1)
+  n=$(grep -a -m1 '^element vertex' "$1" | cut -d' ' -f3)
+  tail -c +$((off + 12)) "$1" | head -c $((n * 24)) | od -An -v -tf4 | tr -s ' ' '\n' | grep -v '^$'
+}
+if part endurance; then
+  nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits -lms 1000 >"$out/endurance.gpumem" 2>/dev/null &
+  smi=$!
+  (while sleep 1; do ps -o rss= -C deformlab; done) >"$out/endurance.rss" 2>/dev/null &
+  rss=$!
+  "$app" run --pipeline cuda-fused --grid 1024x1024 --steps 1000000 --check-every 1000 --no-state \
+    --out /tmp/endurance >"$out/endurance.log" 2>&1
+  kill "$smi" "$rss" 2>/dev/null
+  awk -F, 'NR > 1 { w = int(($1 - 1) / 100000); s[w] += $3; n[w]++ }
+           END { for (k = 0; k in n; k++) printf "%d-%dk: %.5f ms/step\n", k * 100, (k + 1) * 100, s[k] / n[k] }' \
+    /tmp/endurance/timings.csv >"$out/endurance-windows.txt"
+  summary+=("endurance: $(grep -E 'steps:' "$out/endurance.log" | tr -s ' ') windows: $(tr '\n' ';' <"$out/endurance-windows.txt")")
+  summary+=("endurance memory: host RSS kB first/last/max $(head -1 "$out/endurance.rss")/$(tail -1 "$out/endurance.rss")/$(sort -n "$out/endurance.rss" | tail -1); GPU MiB first/last/max $(head -1 "$out/endurance.gpumem")/$(tail -1 "$out/endurance.gpumem")/$(sort -n "$out/endurance.gpumem" | tail -1)")
+  for k in 1 2 3; do
+    "$app" run --pipeline cuda-scatter --grid 512x512 --steps 200 --out "/tmp/scatter$k" >/dev/null 2>&1
+    ply_floats "/tmp/scatter$k/state.ply" >"/tmp/scatter$k.txt"
+  done
+  for k in 2 3; do
+    summary+=("scatter spread, run 1 vs $k (x y z m, vx vy vz m/s; largest |difference| over 512^2 nodes after 200 steps): $(paste /tmp/scatter1.txt /tmp/scatter$k.txt | awk '{ d = $1 - $2; if (d < 0) d = -d; if (d > m) m = d; if ($1 != $2) c++ } END { printf "%.3g, %d of %d values differ", m, c, NR }')")
   done
 fi
 
