@@ -181,7 +181,9 @@ int run_command(const RunArgs& a) {
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     Profiler profiler;
+    profiler.stream_csv(dir.staged("spans.csv").string(), a.trace);  // the trace needs them all
     const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);
+    profiler.end_stream();
     const RunResult& r = ran.result;
     const State final_state = pipe->state();
     const json compare = a.compare ? compare_with_reference(in, final_state, r.steps) : json();
@@ -190,7 +192,6 @@ int run_command(const RunArgs& a) {
     const double med = median(ms);
 
     write_timings_csv(dir.staged("timings.csv"), r);
-    profiler.write_csv(dir.staged("spans.csv").string());
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
     if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
     json manifest = manifest_of(a, in, *pipe, ran, profiler, med, setup_s);

@@ -25,37 +25,66 @@ double Profiler::now_ms() const {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
 }
 
-void Profiler::add(Span s) { spans_.push_back(std::move(s)); }
+namespace {
+
+void write_row(std::ostream& f, const Span& s) {
+  f << s.name << ',' << s.step << ',' << s.start_ms << ',' << s.ms << ",\"" << s.clock << "\"\n";
+}
+
+}  // namespace
+
+void Profiler::add(Span s) {
+  auto it = std::find_if(totals_.begin(), totals_.end(), [&](const Totals& t) { return t.stage.name == s.name; });
+  if (it == totals_.end()) {
+    totals_.push_back({Stage{s.name, s.clock}});
+    it = totals_.end() - 1;
+  } else if (it->stage.clock != s.clock && it->stage.clock.find(s.clock) == std::string::npos) {
+    it->stage.clock += ", " + s.clock;
+  }
+  ++it->stage.spans;
+  it->stage.total_ms += s.ms;
+  if (s.step == it->last_step) {
+    it->per_step.back() += s.ms;  // RK4's four force passes in one step
+  } else {
+    it->per_step.push_back(s.ms);
+    it->last_step = s.step;
+  }
+  if (stream_) write_row(*stream_, s);
+  if (keep_) spans_.push_back(std::move(s));
+}
 
 std::vector<Profiler::Stage> Profiler::summary() const {
   std::vector<Stage> out;
-  std::map<std::string, std::map<int, double>> per_step;  // name -> step -> summed ms
-  for (const Span& s : spans_) {
-    auto it = std::find_if(out.begin(), out.end(), [&](const Stage& g) { return g.name == s.name; });
-    if (it == out.end()) {
-      out.push_back({s.name, s.clock});
-      it = out.end() - 1;
-    } else if (it->clock != s.clock && it->clock.find(s.clock) == std::string::npos) {
-      it->clock += ", " + s.clock;
-    }
-    ++it->spans;
-    it->total_ms += s.ms;
-    per_step[s.name][s.step] += s.ms;
-  }
-  for (Stage& g : out) {
-    std::vector<double> v;
-    for (const auto& [step, ms] : per_step[g.name]) v.push_back(ms);
-    g.steps = int(v.size());
-    g.median_ms = median(std::move(v));
+  for (const Totals& t : totals_) {
+    Stage g = t.stage;
+    g.steps = int(t.per_step.size());
+    g.median_ms = median(t.per_step);
+    out.push_back(std::move(g));
   }
   return out;
+}
+
+void Profiler::stream_csv(const std::string& path, bool keep) {
+  stream_ = std::make_unique<std::ofstream>(path);
+  if (!*stream_) throw std::runtime_error("cannot write " + path);
+  *stream_ << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
+  stream_path_ = path;
+  keep_ = keep;
+}
+
+void Profiler::end_stream() {
+  if (!stream_) return;
+  stream_->close();
+  const bool ok = bool(*stream_);
+  stream_.reset();
+  if (!ok) throw std::runtime_error("writing " + stream_path_ + " failed");
 }
 
 void Profiler::write_csv(const std::string& path) const {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write " + path);
   f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
-  for (const Span& s : spans_) f << s.name << ',' << s.step << ',' << s.start_ms << ',' << s.ms << ",\"" << s.clock << "\"\n";
+  for (const Span& s : spans_) write_row(f, s);
   if (!f) throw std::runtime_error("writing " + path + " failed");
 }
 

@@ -5,6 +5,8 @@
 // NVTX header is header-only; the ranges cost nothing unless a tool is attached).
 #pragma once
 #include <chrono>
+#include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,7 +45,14 @@ class Profiler {
   void set_step(int step) { step_ = step; }
   int step() const { return step_; }
   void add(Span s);
+  // The spans kept (all of them, unless streamed without keeping them).
   const std::vector<Span>& spans() const { return spans_; }
+  // From now on each span is written to the CSV file `path` as it is added (as write_csv
+  // writes them) and kept in spans() only with `keep`; summary() needs neither. A long run
+  // then holds one number per step and stage instead of its spans.
+  void stream_csv(const std::string& path, bool keep);
+  // Flushes and closes the streamed file (throws std::runtime_error when writing failed).
+  void end_stream();
 
   // Per span name, in the order names first appear: the spans of one step summed (RK4 has
   // four force passes), then the median over the steps that have the span.
@@ -63,8 +72,17 @@ class Profiler {
   void write_trace(const std::string& path) const;
 
  private:
+  struct Totals {  // what summary() needs of one span name
+    Stage stage;
+    std::vector<double> per_step;  // summed ms of each step with the span
+    int last_step = -1;
+  };
   std::chrono::steady_clock::time_point t0_;
   std::vector<Span> spans_;
+  std::vector<Totals> totals_;
+  std::unique_ptr<std::ofstream> stream_;
+  std::string stream_path_;
+  bool keep_ = true;
   int step_ = 0;
 };
 

@@ -35,6 +35,43 @@ TEST(Profiler, SummarySumsSpansPerStepThenTakesTheMedian) {
   EXPECT_DOUBLE_EQ(s[1].median_ms, 0.5);
 }
 
+// Streamed spans: the file holds what write_csv writes, the summary is the same, and
+// without keeping them the profiler holds no spans (a long run's memory stays flat).
+TEST(Profiler, StreamsSpansWithTheSameSummary) {
+  const auto dir = std::filesystem::temp_directory_path() / ("deformlab_stream_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  Profiler kept, streamed;
+  streamed.stream_csv((dir / "streamed.csv").string(), false);
+  for (Profiler* p : {&kept, &streamed})
+    for (int step = 1; step <= 50; ++step) {
+      p->add({span::force, step, 0.0, 0.01 * step, "CUDA events"});
+      p->add({span::force, step, 0.0, 0.02, "CUDA events"});
+      p->add({span::reductions, step, 0.0, 1.0 / step, "host clock"});
+    }
+  streamed.end_stream();
+  kept.write_csv((dir / "kept.csv").string());
+  auto slurp = [](const std::filesystem::path& f) {
+    std::ifstream in(f);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(slurp(dir / "streamed.csv"), slurp(dir / "kept.csv"));
+  EXPECT_TRUE(streamed.spans().empty());
+  EXPECT_EQ(kept.spans().size(), 150u);
+  const auto a = kept.summary(), b = streamed.summary();
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(a[k].name, b[k].name);
+    EXPECT_EQ(a[k].steps, 50);
+    EXPECT_EQ(a[k].spans, b[k].spans);
+    EXPECT_DOUBLE_EQ(a[k].median_ms, b[k].median_ms);
+  }
+  EXPECT_DOUBLE_EQ(a[0].median_ms, 0.01 * 26 + 0.02);  // the upper median of 50 step sums
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Profiler, WritesCsvAndAChromeTrace) {
   Profiler p;
   p.set_step(1);
