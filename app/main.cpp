@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) a.argv.emplace_back(argv[i]);
 
   auto* run = cli.add_subcommand("run", "Run an experiment (with no options: the paper's drag experiment)");
-  run->add_option("--experiment", a.experiment, "Experiment file (default: the built-in paper-drag)");
+  run->add_option("--experiment", a.experiment, "Experiment file or built-in name, e.g. table2 (default: paper-drag)");
   run->add_option("--scene", a.scene, "Scene file overriding the experiment's scene");
   run->add_option("--pipeline,-p", a.pipeline, "Pipeline name ('deformlab list'), or 'best'");
   run->add_option("--integrator,-i", a.integrator, "Integrator name ('deformlab list')");

@@ -45,7 +45,7 @@ Experiment read_experiment(const RunArgs& a) {
 #else
   if (a.frames || a.gl_device) throw BadInput("--frames and --gl-device need a build with OpenGL");
 #endif
-  Experiment x = a.experiment ? load_experiment(*a.experiment) : default_experiment();
+  Experiment x = a.experiment ? load_experiment_by_name(*a.experiment) : default_experiment();
   if (a.scene) x.scene = load_scene(*a.scene);
   if (a.pipeline) x.pipeline = *a.pipeline;
   if (a.integrator) x.integrator = *a.integrator;

@@ -10,10 +10,16 @@
 
 namespace deformlab::bench {
 
-// The benches' scene: an n x n cloth of 1 m with its top corners pinned, dt 1 ms (under the
-// stability limit of these grids for the symplectic schemes); pipelines start from rest.
+// The benches' scenes, n x n cloths from rest. `paper`, every bench's main row: the table2
+// experiment's scene (spring damping, ground, sphere, the centre node dragged, dt 50 us).
+// `idealised`: 1 m, top corners pinned, undamped springs, no contact, no drag, dt 1 ms.
+enum class SceneKind { paper, idealised };
+SceneKind parse_scene_kind(const std::string& s);  // throws std::invalid_argument
+const char* to_string(SceneKind k);
+std::string describe(SceneKind k);
+
 struct BenchScene {
-  explicit BenchScene(int n);
+  BenchScene(int n, SceneKind k);
   Model model;
   Params params;
   PipelineSetup setup(Integrator i) const { return {model, params, i}; }
@@ -28,14 +34,16 @@ Stats stats(std::vector<double> ms);
 // `v` with `prec` decimals; "-" for NaN (not measured).
 std::string fixed(double v, int prec);
 
-// The flags every bench takes: grid sizes, warm-up steps, integrator, CSV file.
+// The flags every bench takes: grid sizes, scene, warm-up steps, integrator, CSV file.
 struct BenchOptions {
   std::vector<int> sizes;
+  std::string scene = "paper";
   int warmup = 5;
   std::string integrator = "semi-implicit-euler";
   std::string csv;  // also write the rows here when set
   // `integrator` parsed; throws std::invalid_argument naming it when unknown.
   Integrator integ() const;
+  SceneKind scene_kind() const { return parse_scene_kind(scene); }
 };
 void add_bench_options(CLI::App& c, BenchOptions& o);
 

@@ -1,5 +1,4 @@
 // `deformlab-bench cpu`: the paper's Table 1 shape, cpu vs omp, ms per step.
-#include <chrono>
 #include <iomanip>
 #include <iostream>
 
@@ -10,34 +9,25 @@ namespace deformlab::bench {
 
 namespace {
 
-void time_steps(Pipeline& p, int reps, std::vector<double>& ms) {
-  using clock = std::chrono::steady_clock;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = clock::now();
-    p.step();
-    ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
-  }
-}
-
 void run_cpu(const StepOptions& o) {
   const Integrator integ = o.integ();
+  const SceneKind kind = o.scene_kind();
   std::cout << "deformlab-bench cpu: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
+            << describe(kind) << "\n"
             << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
             << o.reps << " timed steps; omp uses all hardware threads\n\n"
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
   std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
-    const BenchScene scene(n);
+    const BenchScene scene(n, kind);
     const Model& m = scene.model;
     Stats st[2];
     for (int k = 0; k < 2; ++k) {
       auto pipe = make_cpu_pipeline(scene.setup(integ), Precision::f32, k == 1);
-      std::vector<double> ms;
-      time_steps(*pipe, o.warmup, ms);
-      ms.clear();
-      time_steps(*pipe, o.reps, ms);
-      st[k] = stats(ms);
+      const auto timer = pipe->step_timer();
+      timed_steps(*pipe, *timer, o.warmup);
+      st[k] = stats(timed_steps(*pipe, *timer, o.reps));
       if (csv) csv << n << "x" << n << "," << m.node_count() << "," << (k ? "omp" : "cpu") << "," << st[k].median
                    << "," << st[k].min << "," << st[k].p90 << "\n";
     }

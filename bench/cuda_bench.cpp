@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <numeric>
 
 #include "bench.hpp"
 #include "core/state.hpp"
@@ -31,19 +32,23 @@ cuda::Variant parse_variant(const std::string& s) {
   throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused)");
 }
 
-// Median ms per step from the rest state: warm-up steps, then `batches` batches timed by
-// CUDA events, each long enough to last about a millisecond (3 to 100 steps).
+double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
+
+// Median ms per step from the rest state: warm-up steps, then `batches` batches of steps
+// (each about a millisecond: 3 to 100 steps), a batch's figure the mean of its steps, each
+// step between CUDA events (the pipeline's step clock).
 Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, int warmup, int batches) {
   p.set_state(rest_state(m));
-  const double warm = p.timed_steps(warmup) / warmup;
+  const auto timer = p.step_timer();
+  const double warm = mean(timed_steps(p, *timer, warmup));
   const int steps = std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100);
   std::vector<double> ms;
-  for (int b = 0; b < batches; ++b) ms.push_back(p.timed_steps(steps) / steps);
+  for (int b = 0; b < batches; ++b) ms.push_back(mean(timed_steps(p, *timer, steps)));
   return stats(ms);
 }
 
 struct Row {
-  std::string table, grid, variant, integrator, tile;
+  std::string table, scene, grid, variant, integrator, tile;
   bool graphs;
   std::int64_t nodes;
   double ms, floor_bytes, gbs, of_copy;
@@ -53,15 +58,16 @@ class Report {
  public:
   Report(const CudaOptions& o, double copy_gbs)
       : copy_gbs_(copy_gbs),
-        csv_(open_csv(o.csv, "table,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,"
+        csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,"
                              "effective_GBps,fraction_of_copy")) {}
-  Row measure(const std::string& table, const BenchScene& scene, Integrator integ, const cuda::Options& opt,
-              const CudaOptions& o) {
+  Row measure(const std::string& table, SceneKind kind, const BenchScene& scene, Integrator integ,
+              const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
     auto p = cuda::make_pipeline(scene.setup(integ), opt);
     const Stats st = ms_per_step(*p, m, o.warmup, o.batches);
     Row r;
     r.table = table;
+    r.scene = to_string(kind);
     r.grid = std::to_string(m.nx) + "^2";
     r.variant = cuda::to_string(opt.variant);
     r.integrator = std::string(info(integ).name);
@@ -73,7 +79,7 @@ class Report {
     r.gbs = r.floor_bytes * double(r.nodes) / (r.ms * 1e-3) / 1e9;
     r.of_copy = r.gbs / copy_gbs_;
     if (csv_)
-      csv_ << r.table << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator << "," << r.tile
+      csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator << "," << r.tile
            << "," << r.graphs << "," << r.ms << "," << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
     return r;
   }
@@ -86,6 +92,7 @@ class Report {
 void run_cuda(const CudaOptions& o) {
   if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
   const Integrator integ = o.integ();
+  const SceneKind kind = o.scene_kind();
   std::vector<cuda::Variant> variants;
   for (const auto& v : o.variants) variants.push_back(parse_variant(v));
 
@@ -96,22 +103,24 @@ void run_cuda(const CudaOptions& o) {
   std::cout << "deformlab-bench cuda: " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
-            << "method: CUDA events around batches of steps (each batch about 1 ms, 3..100 steps) after " << o.warmup
-            << " warm-up steps; median of " << o.batches << " batches, in ms per step.\n"
-            << "cloth grid n x n, 12 springs per interior node, top corners pinned, dt 1 ms, from rest.\n"
+            << "method: CUDA events around each step (the pipeline's step clock) after " << o.warmup
+            << " warm-up steps; batches of about 1 ms (3..100 steps) each giving its mean; median of " << o.batches
+            << " batches, in ms per step.\n"
+            << "cloth grid n x n, 12 springs per interior node. " << describe(kind) << ";\n"
+            << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
             << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
             << "device of " << o.copy_mib << " MiB, " << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);
-  std::cout << "\n[steps] " << o.integrator << ", tile 16x8, step graphs on\n"
+  std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", tile 16x8, step graphs on\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
             << "B/node" << std::setw(10) << "GB/s" << std::setw(10) << "of copy" << "\n";
   for (int n : o.sizes) {
-    const BenchScene scene(n);
+    const BenchScene scene(n, kind);
     for (cuda::Variant v : variants) {
-      const Row r = rep.measure("steps", scene, integ, {v, {}, true}, o);
+      const Row r = rep.measure("steps", kind, scene, integ, {v, {}, true}, o);
       std::cout << std::setw(8) << r.grid << std::setw(10) << r.variant << std::setw(12) << fixed(r.ms, 4)
                 << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(10) << fixed(r.gbs, 0) << std::setw(9)
                 << fixed(100 * r.of_copy, 1) << "%\n";
@@ -119,31 +128,32 @@ void run_cuda(const CudaOptions& o) {
   }
 
   if (!o.graph_sizes.empty()) std::cout << "\n[graphs] launch overhead: ms/step with and without the step captured as a CUDA graph ("
-            << o.integrator << ")\n"
+            << o.integrator << ", idealised scene: a moving drag handle changes the step's arguments, so the paper "
+            "scene is not replayed)\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "graph" << std::setw(12)
             << "launches" << std::setw(10) << "gain" << "\n";
   for (int n : o.graph_sizes) {
-    const BenchScene scene(n);
+    const BenchScene scene(n, SceneKind::idealised);
     for (cuda::Variant v : {cuda::Variant::fused, cuda::Variant::naive}) {
-      const Row g = rep.measure("graphs", scene, integ, {v, {}, true}, o);
-      const Row l = rep.measure("graphs", scene, integ, {v, {}, false}, o);
+      const Row g = rep.measure("graphs", SceneKind::idealised, scene, integ, {v, {}, true}, o);
+      const Row l = rep.measure("graphs", SceneKind::idealised, scene, integ, {v, {}, false}, o);
       std::cout << std::setw(8) << g.grid << std::setw(10) << g.variant << std::setw(12) << fixed(g.ms, 4)
                 << std::setw(12) << fixed(l.ms, 4) << std::setw(9) << fixed(l.ms / g.ms, 2) << "x\n";
     }
   }
 
   if (o.tile_size > 0 && !o.tiles.empty()) {
-    std::cout << "\n[tiles] block shape sweep at " << o.tile_size << "^2 (" << o.integrator
+    std::cout << "\n[tiles] block shape sweep at " << o.tile_size << "^2 (" << to_string(kind) << " scene, " << o.integrator
               << "): ms/step; tiled stages the block + 2-node halo in shared memory\n"
               << std::setw(8) << "tile" << std::setw(12) << "tiled" << std::setw(12) << "naive" << std::setw(12)
               << "fused" << "\n";
-    const BenchScene scene(o.tile_size);
+    const BenchScene scene(o.tile_size, kind);
     for (const auto& t : o.tiles) {
       const cuda::Tile tile = cuda::parse_tile(t);
       std::cout << std::setw(8) << t;
       for (cuda::Variant v : {cuda::Variant::tiled, cuda::Variant::naive, cuda::Variant::fused})
         std::cout << std::setw(12)
-                  << fixed(rep.measure("tiles", scene, integ, {v, tile, true}, o).ms, 4);
+                  << fixed(rep.measure("tiles", kind, scene, integ, {v, tile, true}, o).ms, 4);
       std::cout << "\n";
     }
   }
@@ -152,12 +162,13 @@ void run_cuda(const CudaOptions& o) {
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 against the copy ceiling and the "
               << "paper author's CUDA Verlet cloth kernel (" << o.reference_ms << " ms per step at 2048^2 on this "
               << "machine type)\n"
-              << std::setw(22) << "integrator" << std::setw(12) << "ms/step" << std::setw(10) << "B/node"
-              << std::setw(10) << "of copy" << std::setw(14) << "vs reference" << "\n";
-    const BenchScene scene(o.tile_size);
+              << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step" << std::setw(10)
+              << "B/node" << std::setw(10) << "of copy" << std::setw(14) << "vs reference" << "\n";
+    for (SceneKind k : {SceneKind::paper, SceneKind::idealised})
     for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet}) {
-      const Row r = rep.measure("fused", scene, i, {cuda::Variant::fused, {}, true}, o);
-      std::cout << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4) << std::setw(10)
+      const BenchScene scene(o.tile_size, k);
+      const Row r = rep.measure("fused", k, scene, i, {cuda::Variant::fused, {}, true}, o);
+      std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4) << std::setw(10)
                 << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%" << std::setw(13)
                 << fixed(o.reference_ms / r.ms, 2) << "x\n";
     }

@@ -14,21 +14,14 @@ namespace deformlab::bench {
 
 namespace {
 
-// GPU ms per step of a GL pipeline: its profiled force+update span of each step after the warm-up.
+// GPU ms per step of a GL pipeline, each step on its step clock after the warm-up.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   p.set_state(rest_state(m));
-  for (int k = 0; k < o.warmup; ++k) p.step();
-  Profiler prof;
-  p.set_profiler(&prof);
-  for (int k = 1; k <= o.reps; ++k) {
-    prof.set_step(k);
-    p.step();
-  }
-  p.set_profiler(nullptr);
-  std::vector<double> ms;
-  for (const Span& sp : prof.spans()) ms.push_back(sp.ms);
+  const auto timer = p.step_timer();
+  timed_steps(p, *timer, o.warmup);
+  const Stats s = stats(timed_steps(p, *timer, o.reps));
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
-  return stats(ms);
+  return s;
 }
 
 // Two vec4 attributes copied by a vertex shader into two transform feedback buffers,
@@ -86,7 +79,9 @@ Stats time_passthrough(int n, const StepOptions& o) {
 void run_gl(const StepOptions& o) {
   const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
+  const SceneKind kind = o.scene_kind();
   std::cout << "deformlab-bench gl: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
+            << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
             << "method: " << gl::Timer().method() << " around each step, " << o.warmup
             << " warm-up steps, median of " << o.reps << " timed steps\n"
@@ -97,7 +92,7 @@ void run_gl(const StepOptions& o) {
             << std::setw(18) << "compute Mnodes/s" << "\n";
   std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
-    const BenchScene scene(n);
+    const BenchScene scene(n, kind);
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
     Stats ceiling = time_passthrough(m.node_count(), o), tf, compute;

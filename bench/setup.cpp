@@ -7,13 +7,44 @@
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
+#include "core/scene.hpp"
+#include "experiments/experiment.hpp"
 
 namespace deformlab::bench {
 
-BenchScene::BenchScene(int n) : model(cloth_grid(n, n, 1.f / float(n - 1), 1.f, Material{})) {
-  pin(model, pin_nodes(model, PinSet::top_corners, {}));
-  params.dt = 0.001f;
+SceneKind parse_scene_kind(const std::string& s) {
+  for (SceneKind k : {SceneKind::paper, SceneKind::idealised})
+    if (s == to_string(k)) return k;
+  throw std::invalid_argument("unknown bench scene '" + s + "' (paper, idealised)");
 }
+
+const char* to_string(SceneKind k) { return k == SceneKind::paper ? "paper" : "idealised"; }
+
+std::string describe(SceneKind k) {
+  if (k == SceneKind::paper)
+    return "paper scene: the table2 experiment's (spring damping, ground, a sphere, the centre node dragged on its "
+           "path, dt 50 us), from rest";
+  return "idealised scene: 1 m, top corners pinned, undamped springs, no contact, no drag, dt 1 ms, from rest";
+}
+
+namespace {
+Scene scene_of(int n, SceneKind k) {
+  Scene s;
+  if (k == SceneKind::paper) {
+    s = load_experiment_by_name("table2").scene;
+  } else {
+    s.model.material = Material{};
+    s.params.dt = 0.001f;
+  }
+  s.model.nx = s.model.ny = n;
+  return s;
+}
+}  // namespace
+
+BenchScene::BenchScene(int n, SceneKind k) : model(build_model(scene_of(n, k))) {
+  params = resolve_params(scene_of(n, k), model);
+}
+
 
 Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};
@@ -36,6 +67,7 @@ Integrator BenchOptions::integ() const {
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
+  c.add_option("--scene", o.scene, "Scene: paper (table2's) or idealised");
   c.add_option("--warmup", o.warmup, "Warm-up steps")->check(CLI::PositiveNumber);
   c.add_option("--integrator", o.integrator, "Integrator");
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");

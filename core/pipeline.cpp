@@ -5,6 +5,15 @@
 
 namespace deformlab {
 
+std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    t.begin();
+    p.step();
+    t.end();
+  }
+  return t.take();
+}
+
 void PipelineRegistry::add(PipelineEntry e) {
   if (find(e.name)) throw std::logic_error("pipeline registered twice: " + e.name);
   entries_.push_back(std::move(e));

@@ -13,6 +13,7 @@
 #include "params.hpp"
 #include "profiler.hpp"
 #include "state.hpp"
+#include "step_timer.hpp"
 
 namespace deformlab {
 
@@ -25,7 +26,10 @@ class Pipeline {
   // Largest node displacement |x_{n+1} - x_n| of the last step, computed where the state
   // lives; NaN when any position or velocity is not finite.
   virtual double max_displacement() = 0;
-  // How step times are measured ("host clock", "CUDA events", "GL timer queries").
+  // A timer of this pipeline's steps on the clock of the device that runs them (valid while
+  // the pipeline lives). The default: the host clock, for pipelines that step on the host.
+  virtual std::unique_ptr<StepTimer> step_timer() { return std::make_unique<HostStepTimer>(); }
+  // How the profiler's stage spans are timed ("host clock", "CUDA events", "GL timer queries").
   virtual std::string timing_method() const { return "host clock (steady_clock)"; }
   // Pipelines that time their stages add spans (force, hand-off, update, ...) to `p` from
   // now on; null stops it. The default records nothing.
@@ -83,6 +87,10 @@ struct PipelineEntry {
 // limit that refuses it. The device's share is checked when the pipeline is built.
 std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
                                   const PipelineOptions& o, const PipelineEntry* reference = nullptr);
+
+// Runs `steps` steps of `p`, each timed by `t` (one of p's timers, with nothing pending);
+// their ms in order.
+std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps);
 
 class PipelineRegistry {
  public:

@@ -52,6 +52,46 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i) {
   return os.str();
 }
 
+namespace {
+
+// Each step's time on the pipeline's step clock, filled into the records kBatch steps at a
+// time (reading them waits for the device) and at the end.
+class StepTimes {
+ public:
+  StepTimes(Pipeline& pipe, RunResult& r, Profiler* prof) : timer_(pipe.step_timer()), r_(r), prof_(prof) {
+    r.clock = timer_->clock();
+  }
+  void begin() {
+    start_ms_.push_back(prof_ ? prof_->now_ms() : 0.0);
+    timer_->begin();
+  }
+  void end() { timer_->end(); }
+  // After the step's record is added.
+  void after_step() {
+    if (r_.records.size() - filled_ >= kBatch) fill();
+  }
+  void fill() {
+    const std::vector<double> ms = timer_->take();
+    for (std::size_t k = 0; k < ms.size(); ++k, ++filled_) {
+      StepRecord& rec = r_.records[filled_];
+      rec.ms = ms[k];
+      r_.total_ms += ms[k];
+      if (prof_) prof_->add({span::step, rec.step, start_ms_[k], ms[k], r_.clock});
+    }
+    start_ms_.clear();
+  }
+
+ private:
+  static constexpr std::size_t kBatch = 1024;
+  std::unique_ptr<StepTimer> timer_;
+  RunResult& r_;
+  Profiler* prof_;
+  std::size_t filled_ = 0;
+  std::vector<double> start_ms_;  // host clock at each pending step's start
+};
+
+}  // namespace
+
 RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions& opt) {
   using clock = std::chrono::steady_clock;
   RunResult r;
@@ -59,16 +99,19 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
   const double runaway = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   pipe.set_profiler(opt.profiler);
+  StepTimes times(pipe, r, opt.profiler);
+  const auto start = clock::now();
   for (int step = 1; step <= p.max_steps; ++step) {
     if (opt.profiler) opt.profiler->set_step(step);
     const auto t0 = clock::now();
+    times.begin();
     {
-      HostSpan span(opt.profiler, span::step);
+      NvtxRange range(span::step);
       pipe.step();
     }
-    const double ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    times.end();
+    const double queue_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     const double t = step * double(p.dt);
-    r.total_ms += ms;
     r.steps = step;
     double disp = std::numeric_limits<double>::quiet_NaN();
     const bool check = step % p.check_every == 0 || step == p.max_steps;
@@ -88,13 +131,16 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
         throw DivergenceError(step, os.str());
       }
     }
-    r.records.push_back({step, t, ms, disp});
+    r.records.push_back({step, t, std::numeric_limits<double>::quiet_NaN(), queue_ms, disp});
+    times.after_step();
     if (opt.after_step) opt.after_step(step);
     if (opt.until_converged && check && step >= p.min_steps && t >= drag_end && disp < p.threshold) {
       r.converged = true;
       break;
     }
   }
+  times.fill();  // waits for the last step
+  r.wall_ms = std::chrono::duration<double, std::milli>(clock::now() - start).count();
   pipe.set_profiler(nullptr);  // collects the spans still pending
   return r;
 }

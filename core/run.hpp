@@ -34,7 +34,8 @@ class DivergenceError : public std::runtime_error {
 struct StepRecord {
   int step;
   double t;                 // simulated time after the step, s
-  double ms;                // wall time of the step, ms (host clock)
+  double ms;                // time of the step on the pipeline's step clock (RunResult::clock), ms
+  double queue_ms;          // host clock around step(), ms: on a GPU pipeline the time to queue it
   double max_displacement;  // m; NaN where the step was not checked
 };
 
@@ -42,7 +43,11 @@ struct RunResult {
   int steps = 0;
   bool converged = false;
   double last_displacement = 0.0;
-  double total_ms = 0.0;
+  double total_ms = 0.0;  // of the steps, on the step clock
+  // Host clock from the first step to the device's end of the last, with the checks and the
+  // after_step calls in between: what the run took.
+  double wall_ms = 0.0;
+  std::string clock;      // the step clock (Pipeline::step_timer)
   std::vector<StepRecord> records;
 };
 
@@ -50,7 +55,8 @@ struct RunOptions {
   bool until_converged = false;  // else run exactly params.max_steps steps
   // Called after every step (e.g. to write frames); may be empty.
   std::function<void(int step)> after_step;
-  // When set: the pipeline's own stage spans, plus "step" and "reductions" on the host clock.
+  // When set: the pipeline's own stage spans, "step" on the step clock and "reductions" on
+  // the host clock.
   Profiler* profiler = nullptr;
   Integrator integrator = Integrator::semi_implicit_euler;  // the pipeline's, for the divergence message
 };

@@ -1,6 +1,7 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
 // and the device reductions (displacement, energy); and its force pass on its own, the CUDA
 // stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels.
+#include <cub/device/device_reduce.cuh>
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -8,9 +9,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <type_traits>
+#include <utility>
+#include <vector>
 #include <stdexcept>
 
 #include "check.cuh"
@@ -161,15 +165,6 @@ class ForceKernels {
   Buffer<Spring> springs_;
 };
 
-struct DispOp {  // the stop rule's term of node i (infinite where the state is not finite)
-  const float4* x;
-  const float4* x_old;
-  const float4* v;
-  __device__ float operator()(int i) const {
-    return P::displacement(dev::xyz(x[i]), dev::xyz(x_old[i]), dev::xyz(v[i]));
-  }
-};
-
 using PD = Physics<double>;
 __host__ __device__ Vec3d widen(const Vec3f& a) { return {a.x, a.y, a.z}; }
 
@@ -215,6 +210,58 @@ struct GridSpringEnergyOp {
   }
 };
 
+// Steps timed back to back by one CUDA event at each step's end (and one before the first step
+// after a take): a step's time runs from the end of the step before to its own, as the device
+// ran them, idle time between them included. A pair of events around each step would instead
+// add the device's launch latency to every step replayed from a graph (10 us of 130 at 2048^2
+// on the H100).
+class EventStepTimer final : public StepTimer {
+ public:
+  explicit EventStepTimer(cudaStream_t s) : s_(s) {}
+  ~EventStepTimer() override {
+    for (cudaEvent_t e : events_) cudaEventDestroy(e);
+  }
+  void begin() override {
+    if (marks_ == 0) mark();
+  }
+  void end() override {
+    mark();
+    if (marks_ > 4096) resolve();
+  }
+  std::vector<double> take() override {
+    resolve();
+    marks_ = 0;
+    return std::exchange(done_, {});
+  }
+  std::string clock() const override { return "CUDA events"; }
+
+ private:
+  void mark() {
+    if (marks_ == events_.size()) {
+      cudaEvent_t e = nullptr;
+      check(cudaEventCreate(&e), "creating a timing event");
+      events_.push_back(e);
+    }
+    check(cudaEventRecord(events_[marks_++], s_), "recording a step's end");
+  }
+  // The steps marked so far into done_; the last mark stays as the next step's start.
+  void resolve() {
+    if (marks_ == 0) return;
+    check(cudaEventSynchronize(events_[marks_ - 1]), "waiting for the timed steps");
+    for (std::size_t k = 1; k < marks_; ++k) {
+      float ms = 0.f;
+      check(cudaEventElapsedTime(&ms, events_[k - 1], events_[k]), "reading the step timer");
+      done_.push_back(double(ms));
+    }
+    std::swap(events_[0], events_[marks_ - 1]);
+    marks_ = 1;
+  }
+  cudaStream_t s_;
+  std::vector<cudaEvent_t> events_;
+  std::size_t marks_ = 0;  // events recorded since the last resolve
+  std::vector<double> done_;
+};
+
 class Impl final : public CudaPipeline, private ForceKernels, private ForceStage, private UpdateStage {
  public:
   Impl(const PipelineSetup& su, const Options& o)
@@ -224,8 +271,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
-    check(cudaEventCreate(&ev_[0]), "creating a timing event");
-    check(cudaEventCreate(&ev_[1]), "creating a timing event");
 
     for (auto& b : x_) b.allocate(n_, "allocating positions");
     for (auto& b : v_) b.allocate(n_, "allocating velocities");
@@ -235,6 +280,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
     if (!fused_)
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
+    warp_max_.allocate(std::max(warps_of(dim3(blocks_for(n_)), dim3(kBlock)), warps_of(grid_blocks(), grid_threads())),
+                       "allocating the stop rule's warp maxima");
+    stop_max_.allocate(1, "allocating the largest displacement");
+    std::size_t bytes = 0;
+    check(cub::DeviceReduce::Max(nullptr, bytes, warp_max_.get(), stop_max_.get(), std::int64_t(warp_max_.size())),
+          "sizing the displacement reduction");
+    reduce_temp_.allocate(bytes, "allocating the displacement reduction");
 
     set_state(rest_state(m));
   }
@@ -242,8 +294,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   ~Impl() override {
     for (auto& g : graph_)
       if (g) cudaGraphExecDestroy(g);
-    cudaEventDestroy(ev_[0]);
-    cudaEventDestroy(ev_[1]);
     if (stream_) cudaStreamDestroy(stream_);
   }
 
@@ -284,13 +334,19 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     stepped_ = true;
   }
 
+  // The largest of the last step's warp maxima (dev::StopCheck): one small reduction and a
+  // word read back.
   double max_displacement() override {
     if (!stepped_) return 0.0;
-    const float d = thrust::transform_reduce(thrust::cuda::par.on(stream_), thrust::counting_iterator<int>(0),
-                                             thrust::counting_iterator<int>(n_),
-                                             DispOp{x_[cur_].get(), x_[1 - cur_].get(), v_[cur_].get()}, 0.f,
-                                             thrust::maximum<float>());
+    std::size_t bytes = reduce_temp_.size();
+    check(cub::DeviceReduce::Max(reduce_temp_.get(), bytes, warp_max_.get(), stop_max_.get(), stop_warps_, stream_),
+          "reducing the largest displacement");
+    unsigned* h = reinterpret_cast<unsigned*>(staging());
+    check(cudaMemcpyAsync(h, stop_max_.get(), sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
+          "reading the largest displacement");
     check(cudaStreamSynchronize(stream_), "reducing the largest displacement");
+    float d = 0.f;
+    std::memcpy(&d, h, sizeof d);
     return std::isinf(d) ? std::numeric_limits<double>::quiet_NaN() : double(d);
   }
 
@@ -323,15 +379,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     prof_ = p;
   }
 
-  double timed_steps(int steps) override {
-    check(cudaEventRecord(ev_[0], stream_), "recording the start event");
-    for (int k = 0; k < steps; ++k) step();
-    check(cudaEventRecord(ev_[1], stream_), "recording the end event");
-    check(cudaEventSynchronize(ev_[1]), "running the timed steps");
-    float ms = 0.f;
-    check(cudaEventElapsedTime(&ms, ev_[0], ev_[1]), "reading the step timer");
-    return ms;
-  }
+  std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<EventStepTimer>(stream_); }
 
  private:
   // State transfers go through the pipeline's stream (ordered after the steps already queued)
@@ -468,19 +516,30 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const Targets tg = targets();
     if (!fused) {
       dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), xp, has_prev_, xo, vo,
-                                                                tg.end);
+                                                                tg.end, stop_check(blocks_for(n_), kBlock));
       check_launch("launching the update kernel");
     } else if (!model_.grid()) {
       dev::fused_csr<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp,
-                                                                   has_prev_, xo, vo, tg);
+                                                                   has_prev_, xo, vo, tg,
+                                                                   stop_check(blocks_for(n_), kBlock));
       check_launch("launching the fused CSR step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
-            <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg);
+            <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg,
+                                                            stop_check(grid_blocks(), grid_threads()));
       });
       check_launch("launching the fused step kernel");
     }
+  }
+
+  static std::int64_t warps_of(dim3 blocks, dim3 threads) {
+    return std::int64_t(blocks.x) * blocks.y * blocks.z * ((threads.x * threads.y * threads.z + 31) / 32);
+  }
+  // The stop rule's reduction in the launch that writes the step's result.
+  dev::StopCheck stop_check(dim3 blocks, dim3 threads) {
+    stop_warps_ = warps_of(blocks, threads);
+    return {warp_max_.get()};
   }
 
   // A stage state or the step's result from the slopes with a non-zero weight.
@@ -497,8 +556,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const int nxt = 1 - cur_;
     float4* xo = result ? x_[nxt].get() : sx_[pass.dst - 1].get();
     float4* vo = result ? v_[nxt].get() : sv_[pass.dst - 1].get();
-    dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, result, xo, vo,
-                                                         targets().end);
+    dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, xo, vo,
+                                                         targets().end,
+                                                         result ? stop_check(blocks_for(n_), kBlock) : dev::StopCheck{});
     check_launch("launching the combine kernel");
   }
 
@@ -512,13 +572,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
+  Buffer<unsigned> warp_max_, stop_max_;  // the stop rule's warp maxima (dev::StopCheck), their largest
+  Buffer<unsigned char> reduce_temp_;
+  std::int64_t stop_warps_ = 0;  // of the last step's launch
   struct FreeHost {
     void operator()(float4* p) const { cudaFreeHost(p); }
   };
   std::unique_ptr<float4, FreeHost> staging_;
 
   cudaStream_t stream_ = nullptr;
-  cudaEvent_t ev_[2] = {};
   cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;

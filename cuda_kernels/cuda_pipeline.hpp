@@ -41,8 +41,6 @@ class CudaPipeline : public Pipeline {
  public:
   // Kinetic, spring and field energy of the current state, reduced on the device.
   virtual Energy energy() = 0;
-  // GPU time of `steps` steps, ms, from CUDA events recorded around them.
-  virtual double timed_steps(int steps) = 0;
   std::string timing_method() const override { return "CUDA events"; }
 };
 

@@ -2,18 +2,33 @@
 
 #include <cuda_runtime.h>
 
+#include <utility>
+
 #include "check.cuh"
 
 namespace deformlab::cuda {
 
-EventSpans::~EventSpans() {
+EventTimer::~EventTimer() {
   for (std::size_t k = 0; k < begin_.size(); ++k) {
     cudaEventDestroy(begin_[k]);
     cudaEventDestroy(end_[k]);
   }
 }
 
-void EventSpans::begin(const Profiler& p, const char* name, CUstream_st* s) {
+void EventTimer::resolve(std::size_t count) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t pair = pending_[k];
+    check(cudaEventSynchronize(end_[pair]), "waiting for a timed span");
+    float ms = 0.f;
+    check(cudaEventElapsedTime(&ms, begin_[pair], end_[pair]), "reading a span's CUDA events");
+    done_.push_back(double(ms));
+    free_.push_back(pair);
+  }
+  pending_.erase(pending_.begin(), pending_.begin() + long(count));
+}
+
+void EventTimer::begin(CUstream_st* s) {
+  if (pending_.size() >= 4096) resolve(pending_.size() - 64);  // the older ones are long finished
   if (free_.empty()) {
     cudaEvent_t b = nullptr, e = nullptr;
     check(cudaEventCreate(&b), "creating a timing event");
@@ -22,26 +37,33 @@ void EventSpans::begin(const Profiler& p, const char* name, CUstream_st* s) {
     end_.push_back(e);
     free_.push_back(begin_.size() - 1);
   }
-  const std::size_t k = free_.back();
+  pending_.push_back(free_.back());
   free_.pop_back();
-  pending_.push_back({name, p.step(), p.now_ms(), k});
+  check(cudaEventRecord(begin_[pending_.back()], s), "recording a span's start");
+}
+
+void EventTimer::end(CUstream_st* s) { check(cudaEventRecord(end_[pending_.back()], s), "recording a span's end"); }
+
+std::vector<double> EventTimer::take() {
+  resolve(pending_.size());
+  return std::exchange(done_, {});
+}
+
+void EventSpans::begin(const Profiler& p, const char* name, CUstream_st* s) {
+  pending_.push_back({name, p.step(), p.now_ms()});
   range_.emplace(name);
-  check(cudaEventRecord(begin_[k], s), "recording a span's start");
+  timer_.begin(s);
 }
 
 void EventSpans::end(CUstream_st* s) {
-  check(cudaEventRecord(end_[pending_.back().pair], s), "recording a span's end");
+  timer_.end(s);
   range_.reset();
 }
 
 void EventSpans::collect(Profiler* p) {
-  for (const Pending& s : pending_) {
-    check(cudaEventSynchronize(end_[s.pair]), "waiting for a timed span");
-    float ms = 0.f;
-    check(cudaEventElapsedTime(&ms, begin_[s.pair], end_[s.pair]), "reading a span's CUDA events");
-    if (p) p->add({s.name, s.step, s.start_ms, double(ms), "CUDA events"});
-    free_.push_back(s.pair);
-  }
+  const std::vector<double> ms = timer_.take();
+  for (std::size_t k = 0; k < pending_.size(); ++k)
+    if (p) p->add({pending_[k].name, pending_[k].step, pending_[k].start_ms, ms[k], "CUDA events"});
   pending_.clear();
 }
 

@@ -1,5 +1,5 @@
-// Profiler spans of work queued on a CUDA stream, timed by CUDA events and handed to the
-// profiler once resolved (resolving waits for the work, so it happens in batches).
+// Timing of work queued on CUDA streams by pairs of CUDA events: EventTimer times spans,
+// EventSpans hands them to the profiler with their names.
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -12,13 +12,28 @@ struct CUevent_st;
 
 namespace deformlab::cuda {
 
+// Spans of the work queued on a stream between begin and end, timed by a pair of events each
+// (pairs are reused). Spans of one timer may not nest; several timers may.
+class EventTimer {
+ public:
+  EventTimer() = default;
+  EventTimer(const EventTimer&) = delete;
+  EventTimer& operator=(const EventTimer&) = delete;
+  ~EventTimer();
+  void begin(CUstream_st* s);
+  void end(CUstream_st* s);
+  // ms of the spans ended since the last call, in order (waits for their work).
+  std::vector<double> take();
+
+ private:
+  void resolve(std::size_t count);  // the oldest `count` pending spans into done_
+  std::vector<CUevent_st*> begin_, end_;  // event pairs
+  std::vector<std::size_t> free_, pending_;
+  std::vector<double> done_;  // resolved, not yet taken
+};
+
 class EventSpans {
  public:
-  EventSpans() = default;
-  EventSpans(const EventSpans&) = delete;
-  EventSpans& operator=(const EventSpans&) = delete;
-  ~EventSpans();
-
   // A span of the work queued on `s` between begin and end, at the profiler's current step
   // and host time, with an NVTX range of the same name over the host side. Spans may not nest.
   void begin(const Profiler& p, const char* name, CUstream_st* s);
@@ -32,10 +47,8 @@ class EventSpans {
     const char* name;
     int step;
     double start_ms;
-    std::size_t pair;
   };
-  std::vector<CUevent_st*> begin_, end_;  // event pairs, reused
-  std::vector<std::size_t> free_;
+  EventTimer timer_;
   std::vector<Pending> pending_;
   std::optional<NvtxRange> range_;
 };

@@ -61,7 +61,7 @@ __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stenc
                                                 const Vec3f& xi, const Vec3f& vi, const Window& w) {
   // Four at a time: the fused kernels then keep everything in 48 registers (6 or 8 spilled,
   // costing 2-3% on the H100 at 2048^2).
-  constexpr int G = 4;
+  constexpr int G = Damped ? 2 : 4;
   Vec3f f{};
 #pragma unroll
   for (int g = 0; g < N; g += G) {
@@ -111,10 +111,11 @@ __device__ __forceinline__ Vec3f gather_csr(const int* __restrict__ offset, cons
 
 // The one-pass update (rule RULE_*) and the constraints of node i, written to (xo, vo).
 // x_prev may alias xo (Verlet writes the new positions over the previous ones, node by node).
+// Returns the node's term of the stop rule (P::displacement).
 template <int Rule>
-__device__ __forceinline__ void advance_node(const StepParams& s, float weight, int i, const float4& x4,
-                                             const float4& v4, const Vec3f& a, const float4* x_prev, bool has_prev,
-                                             const Vec3f& end_target, float4* xo, float4* vo) {
+__device__ __forceinline__ float advance_node(const StepParams& s, float weight, int i, const float4& x4,
+                                              const float4& v4, const Vec3f& a, const float4* x_prev, bool has_prev,
+                                              const Vec3f& end_target, float4* xo, float4* vo) {
   const Vec3f x = xyz(x4);
   const Vec3f xp = (Rule == RULE_VERLET && has_prev) ? xyz(x_prev[i]) : Vec3f{};
   Vec3f xn, vn;
@@ -122,6 +123,32 @@ __device__ __forceinline__ void advance_node(const StepParams& s, float weight, 
   P::constrain_node(s, i, x4.w, x, end_target, xn, vn);
   xo[i] = f4(xn, x4.w);
   vo[i] = f4(vn, 0.f);
+  return P::displacement(xn, x, vn);
+}
+
+// The stop rule's reduction, begun by the kernel that writes a step's result: each warp
+// stores the largest term of its nodes (P::displacement: non-negative, infinite where the
+// state is not finite) as the bits of a float, which order as the floats do; the pipeline
+// reduces the warps' values when it is asked. Plain stores: no atomics on one hot address
+// and nothing to clear between steps.
+struct StopCheck {
+  unsigned* warp_max;  // one per warp of the launch; null: no check in this kernel
+};
+
+__device__ __forceinline__ unsigned thread_in_block() {
+  return (threadIdx.z * blockDim.y + threadIdx.y) * blockDim.x + threadIdx.x;
+}
+
+// Called by every thread of the block, with its node's term (0 for a thread without a node).
+// The kernels keep such threads to the end rather than return early: the lanes of a warp are
+// then known without holding a mask through the kernel.
+__device__ __forceinline__ void store_displacement(const StopCheck& c, float d) {
+  const unsigned threads = blockDim.x * blockDim.y * blockDim.z, t = thread_in_block();
+  const unsigned in_warp = min(32u, threads - (t - t % 32));
+  const unsigned bits = __reduce_max_sync(in_warp == 32 ? 0xffffffffu : (1u << in_warp) - 1u, __float_as_uint(d));
+  if (t % 32 != 0) return;
+  const std::int64_t block = (std::int64_t(blockIdx.z) * gridDim.y + blockIdx.y) * gridDim.x + blockIdx.x;
+  c.warp_max[block * ((threads + 31) / 32) + t / 32] = bits;
 }
 
 // ---- grid kernels: block (tile.x, tile.y) over (i, j), grid.z over layers k ----
@@ -181,18 +208,21 @@ template <int N, bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil st, float weight,
                                                          const float4* __restrict__ x, const float4* __restrict__ v,
                                                          const float4* x_prev, bool has_prev, float4* xo,
-                                                         float4* __restrict__ vo, Targets tg) {
+                                                         float4* __restrict__ vo, Targets tg, StopCheck check) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y, k = blockIdx.z;
-  if (i >= s.nx || j >= s.ny) return;
-  const int node = P::grid_node(i, j, k, s.nx, s.ny);
-  const float4 x4 = x[node], v4 = v[node];
-  Vec3f a{};
-  if (!P::node_fixed(s, node, x4.w)) {
-    const Vec3f xi = xyz(x4), vi = xyz(v4);
-    const Window w{x, v, node, s.nx, s.nx * s.ny};
-    a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), tg.force);
+  float d = 0.f;
+  if (i < s.nx && j < s.ny) {
+    const int node = P::grid_node(i, j, k, s.nx, s.ny);
+    const float4 x4 = x[node], v4 = v[node];
+    Vec3f a{};
+    if (!P::node_fixed(s, node, x4.w)) {
+      const Vec3f xi = xyz(x4), vi = xyz(v4);
+      const Window w{x, v, node, s.nx, s.nx * s.ny};
+      a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), tg.force);
+    }
+    d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
   }
-  advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+  store_displacement(check, d);
 }
 
 // ---- general models: one thread per node over the CSR adjacency ----
@@ -219,13 +249,16 @@ __global__ void force_csr(StepParams s, const int* __restrict__ offset, const Li
 template <int Rule>
 __global__ void fused_csr(StepParams s, float weight, const int* __restrict__ offset, const Link* __restrict__ links,
                           const float4* __restrict__ x, const float4* __restrict__ v, const float4* x_prev,
-                          bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg) {
+                          bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg, StopCheck check) {
   const std::int64_t t = thread_index();
-  if (t >= s.node_count) return;
-  const int i = int(t);
-  const float4 x4 = x[i], v4 = v[i];
-  const Vec3f a = csr_accel(s, offset, links, x, v, i, x4, v4, tg.force);
-  advance_node<Rule>(s, weight, i, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+  float d = 0.f;
+  if (t < s.node_count) {
+    const int i = int(t);
+    const float4 x4 = x[i], v4 = v[i];
+    const Vec3f a = csr_accel(s, offset, links, x, v, i, x4, v4, tg.force);
+    d = advance_node<Rule>(s, weight, i, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+  }
+  store_displacement(check, d);
 }
 
 // ---- scatter: one thread per spring, atomics; then per node force sum -> acceleration ----
@@ -280,11 +313,14 @@ __global__ void scatter_finish(StepParams s, const float4* __restrict__ x, const
 template <int Rule>
 __global__ void update(StepParams s, float weight, const float4* __restrict__ x, const float4* __restrict__ v,
                        const float4* __restrict__ acc, const float4* x_prev, bool has_prev, float4* xo,
-                       float4* __restrict__ vo, Vec3f end_target) {
+                       float4* __restrict__ vo, Vec3f end_target, StopCheck check) {
   const std::int64_t t = thread_index();
-  if (t >= s.node_count) return;
-  const int i = int(t);
-  advance_node<Rule>(s, weight, i, x[i], v[i], xyz(acc[i]), x_prev, has_prev, end_target, xo, vo);
+  float d = 0.f;
+  if (t < s.node_count) {
+    const int i = int(t);
+    d = advance_node<Rule>(s, weight, i, x[i], v[i], xyz(acc[i]), x_prev, has_prev, end_target, xo, vo);
+  }
+  store_displacement(check, d);
 }
 
 // The slopes of a Runge-Kutta combination with a non-zero weight, in stage order.
@@ -295,25 +331,31 @@ struct Terms {
   int count;
 };
 
-// A stage state, or (result) the step's result and its constraints: s0 + dt sum_j w_j k_j.
+// A stage state, or (result: the check's slots set) the step's result, its constraints and
+// the stop rule's reduction: s0 + dt sum_j w_j k_j.
 __global__ void combine(StepParams s, const float4* __restrict__ x, const float4* __restrict__ v, Terms terms,
-                        bool result, float4* __restrict__ xo, float4* __restrict__ vo, Vec3f end_target) {
+                        float4* __restrict__ xo, float4* __restrict__ vo, Vec3f end_target, StopCheck check) {
+  const bool result = check.warp_max != nullptr;
   const std::int64_t t = thread_index();
-  if (t >= s.node_count) return;
-  const int i = int(t);
-  Vec3f dx{}, dv{};
+  float d = 0.f;
+  if (t < s.node_count) {
+    const int i = int(t);
+    Vec3f dx{}, dv{};
 #pragma unroll
-  for (int q = 0; q < kMaxStages; ++q) {
-    if (q >= terms.count) break;
-    P::add_slope(dx, dv, terms.weight[q], xyz(terms.v[q][i]), xyz(terms.a[q][i]));
+    for (int q = 0; q < kMaxStages; ++q) {
+      if (q >= terms.count) break;
+      P::add_slope(dx, dv, terms.weight[q], xyz(terms.v[q][i]), xyz(terms.a[q][i]));
+    }
+    const float4 x4 = x[i];
+    const Vec3f x_old = xyz(x4);
+    Vec3f xn, vn;
+    P::rk_state(x_old, xyz(v[i]), dx, dv, s.dt, xn, vn);
+    if (result) P::constrain_node(s, i, x4.w, x_old, end_target, xn, vn);
+    xo[i] = f4(xn, x4.w);
+    vo[i] = f4(vn, 0.f);
+    if (result) d = P::displacement(xn, x_old, vn);
   }
-  const float4 x4 = x[i];
-  const Vec3f x_old = xyz(x4);
-  Vec3f xn, vn;
-  P::rk_state(x_old, xyz(v[i]), dx, dv, s.dt, xn, vn);
-  if (result) P::constrain_node(s, i, x4.w, x_old, end_target, xn, vn);
-  xo[i] = f4(xn, x4.w);
-  vo[i] = f4(vn, 0.f);
+  if (result) store_displacement(check, d);
 }
 
 }  // namespace deformlab::cuda::dev

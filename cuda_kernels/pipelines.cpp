@@ -54,6 +54,7 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   std::int64_t b = n * 4 * f4;  // two (x, v) buffers
   b += n * 2 * f4 * s.stage_states;
   if (!(o.variant == Variant::fused && s.single_pass())) b += n * f4 * s.accel_slots;
+  b += (n / 32 + 1024) * 4 * 2;  // the stop rule's warp maxima (tile padding at most doubles them)
   return b + spring_bytes(m, o.variant);
 }
 

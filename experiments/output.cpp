@@ -116,10 +116,10 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
 void write_timings_csv(const fs::path& file, const RunResult& r) {
   std::ofstream out(file);
   if (!out) throw std::runtime_error("cannot write " + file.string());
-  out << "step,t_s,step_ms,max_displacement_m\n";
+  out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";
   out.precision(9);
   for (const auto& rec : r.records) {
-    out << rec.step << ',' << rec.t << ',' << rec.ms << ',';
+    out << rec.step << ',' << rec.t << ',' << rec.ms << ',' << rec.queue_ms << ',';
     if (rec.max_displacement == rec.max_displacement) out << rec.max_displacement;
     out << '\n';
   }

@@ -47,7 +47,8 @@ class OutputDir {
 // Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their
 // triangles (two per quad) so mesh tools show the surface. numpy reads it via plyfile.
 void write_ply(const std::filesystem::path& file, const Model& m, const State& s);
-// step,t_s,step_ms,max_displacement_m (empty where the step was not checked).
+// step,t_s,step_ms (on the run's step clock),queue_ms (host clock around step()),
+// max_displacement_m (empty where the step was not checked).
 void write_timings_csv(const std::filesystem::path& file, const RunResult& r);
 void write_json(const std::filesystem::path& file, const nlohmann::json& j);
 

@@ -274,21 +274,25 @@ Timer::~Timer() {
   if (!pending_.empty()) glDeleteQueries(GLsizei(pending_.size()), pending_.data());
 }
 
+void Timer::stamp() {
+  if (free_.empty()) {
+    free_.resize(32);
+    glGenQueries(32, free_.data());
+  }
+  const GLuint q = free_.back();
+  free_.pop_back();
+  glQueryCounter(q, GL_TIMESTAMP);
+  pending_.push_back(q);
+}
+
 void Timer::begin() {
   if (software_) {
     glFinish();
     t0_ = std::chrono::steady_clock::now();
     return;
   }
-  if (pending_.size() >= 64) collect(32);  // the older half is long finished
-  if (free_.empty()) {
-    free_.resize(16);
-    glGenQueries(16, free_.data());
-  }
-  const GLuint q = free_.back();
-  free_.pop_back();
-  glBeginQuery(GL_TIME_ELAPSED, q);
-  pending_.push_back(q);
+  if (pending_.size() >= 4096) collect(64);  // the older half is long finished
+  stamp();
 }
 
 void Timer::end() {
@@ -297,16 +301,18 @@ void Timer::end() {
     done_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count());
     return;
   }
-  glEndQuery(GL_TIME_ELAPSED);
+  stamp();
 }
 
 void Timer::collect(std::size_t keep) {
   std::size_t k = 0;
-  for (; k + keep < pending_.size(); ++k) {
-    GLuint64 ns = 0;
-    glGetQueryObjectui64v(pending_[k], GL_QUERY_RESULT, &ns);
-    done_.push_back(double(ns) * 1e-6);
+  for (; k + keep + 1 < pending_.size(); k += 2) {
+    GLuint64 t[2] = {};
+    glGetQueryObjectui64v(pending_[k], GL_QUERY_RESULT, &t[0]);
+    glGetQueryObjectui64v(pending_[k + 1], GL_QUERY_RESULT, &t[1]);
+    done_.push_back(double(t[1] - t[0]) * 1e-6);
     free_.push_back(pending_[k]);
+    free_.push_back(pending_[k + 1]);
   }
   pending_.erase(pending_.begin(), pending_.begin() + long(k));
 }
@@ -318,7 +324,7 @@ std::vector<double> Timer::take() {
 
 std::string Timer::method() const {
   return software_ ? "host clock after glFinish (software OpenGL; its timer queries are not meaningful)"
-                   : "GL timer queries (GL_TIME_ELAPSED)";
+                   : "GL timer queries (GL_TIMESTAMP)";
 }
 
 void TimerSpans::begin(const Profiler& p, const char* name) {

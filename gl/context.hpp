@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/profiler.hpp"
+#include "core/step_timer.hpp"
 
 namespace deformlab::gl {
 
@@ -45,8 +46,9 @@ void check_debug(std::string_view stage);
 // An embedded shader file (DEFORMLAB_SHADER_DIR, if set, overrides the embedded copies).
 std::string shader_file(std::string_view name);
 
-// Times spans of GL work: GL_TIME_ELAPSED queries on a GPU, the host clock after glFinish
-// on a software rasteriser (whose queries read about 1 ns). Spans may not nest.
+// Times spans of GL work: a GL_TIMESTAMP query at each end on a GPU (taken once the commands
+// before it are done), the host clock after glFinish on a software rasteriser (whose queries
+// read about 1 ns). Spans of one timer may not nest; several timers may.
 class Timer {
  public:
   Timer();
@@ -60,15 +62,28 @@ class Timer {
   std::string method() const;
 
  private:
-  void collect(std::size_t keep);  // waits for all but the newest `keep` queries
+  void stamp();                    // a timestamp query after the commands issued so far
+  void collect(std::size_t keep);  // resolves all but the newest `keep` queries
   bool software_;
-  std::vector<unsigned> free_, pending_;
+  std::vector<unsigned> free_, pending_;  // pending: begin, end, begin, end, ...
   std::vector<double> done_;
   std::chrono::steady_clock::time_point t0_;
 };
 
+// Each step between the two ends of a Timer.
+class QueryStepTimer final : public StepTimer {
+ public:
+  void begin() override { t_.begin(); }
+  void end() override { t_.end(); }
+  std::vector<double> take() override { return t_.take(); }
+  std::string clock() const override { return t_.method(); }
+
+ private:
+  Timer t_;
+};
+
 // Profiler spans of GL work, timed by a Timer and handed to the profiler once resolved
-// (resolving waits for the work). Spans may not nest, nor overlap another Timer's spans.
+// (resolving waits for the work). Spans may not nest.
 class TimerSpans {
  public:
   // A span of the GL commands issued between begin and end, at the profiler's current step

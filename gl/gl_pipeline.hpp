@@ -56,6 +56,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   GLuint force_buffer() const { return forces_acc_.id(); }
   double max_displacement() override;
   std::string timing_method() const override { return spans_.method(); }
+  std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<QueryStepTimer>(); }
 
   // The current positions, one vec4 per node (w: inverse mass), ready to be read by GL.
   GLuint position_buffer();

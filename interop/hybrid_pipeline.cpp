@@ -68,9 +68,10 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
   }
   double max_displacement() override { return gl_->max_displacement(); }
   std::string timing_method() const override {
-    return "host clock per step; stages: CUDA events (force), " + gl::Timer().method() +
-           " (update), host clock (hand-off)";
+    return "CUDA events (force), " + gl::Timer().method() + " (update), host clock (hand-off)";
   }
+  // GL's clock: its update pass waits for the CUDA forces, so a step's two GL ends span both.
+  std::unique_ptr<StepTimer> step_timer() override { return gl_->step_timer(); }
   // Spans still pending go to the profiler they were taken for.
   void set_profiler(Profiler* p) override {
     collect();

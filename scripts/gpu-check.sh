@@ -3,12 +3,13 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments scale endurance" to run,
-# default all but scale and endurance),
+# Environment: PARTS (which of "tests sanitizers bench experiments timing scale endurance" to
+# run, default all but timing, scale and endurance),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
-# this build's in the same session, for an A/B comparison).
+# this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
+# timing part's experiment cells again).
 # The build folder can travel as .dev/build.tgz (scripts/pack-for-device.sh), unpacked here.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -34,7 +35,7 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
   for tool in memcheck racecheck synccheck initcheck; do
     {
       compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*'
-      compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*'
+      compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
   done
@@ -57,6 +58,36 @@ if part experiments; then
   for x in ${EXPERIMENTS-table2 table3 tiles interop swap}; do
     "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
     summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
+  done
+fi
+
+# One scene timed three ways (table2's scene at 2048^2, explicit Euler): `deformlab run`, its
+# experiment cell and deformlab-bench; then a run checking the stop rule every step against
+# one checking it once (the run's host wall time).
+median_of() { grep -o "\"$1\": [0-9.e+-]*" "$2" | head -1 | awk '{ print $2 }'; }
+if part timing; then
+  cat >"$out/clock-check.json" <<'JSON'
+{"name": "clock-check", "base": "table2", "integrator": "explicit-euler",
+ "sweep": {"sizes": [2048], "pipelines": ["cuda-fused", "cuda-naive", "glsl-compute", "glsl-tf"],
+           "warmup": 10, "steps": 20, "repetitions": 7, "cell_limit_s": 60}}
+JSON
+  "$app" experiment "$out/clock-check.json" --out "$out/results/clock-check" >"$out/timing-experiment.log" 2>&1
+  [ -n "${BASE_APP:-}" ] && "$BASE_APP" experiment "$out/clock-check.json" --out "$out/results/clock-check-base" \
+    >"$out/timing-experiment-base.log" 2>&1
+  "$bench" cuda --sizes 2048 --variants fused naive --integrator explicit-euler --graph-sizes 64 --tile-size 2048 \
+    --tiles 16x8 --csv "$out/timing-bench-cuda.csv" >"$out/timing-bench-cuda.txt" 2>&1
+  "$bench" gl --sizes 2048 --integrator explicit-euler --csv "$out/timing-bench-gl.csv" >"$out/timing-bench-gl.txt" 2>&1
+  for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
+    "$app" run --experiment table2 --pipeline "$p" --grid 2048x2048 --steps 200 --check-every 100000 --no-state \
+      --out "/tmp/timing-$p" >"$out/timing-run-$p.log" 2>&1
+    cp "/tmp/timing-$p/manifest.json" "$out/timing-run-$p.json"
+    cell=$(ls "$out"/results/clock-check/cells/*"$p"* 2>/dev/null | head -1)
+    summary+=("timing $p 2048^2 paper scene, ms/step: run $(median_of median_step_ms "$out/timing-run-$p.json"), cell $(median_of median_ms "$cell")")
+  done
+  for every in 1 400; do
+    "$app" run --experiment table2 --pipeline cuda-fused --grid 2048x2048 --steps 400 --check-every "$every" --no-state \
+      --out "/tmp/check-$every" >"$out/timing-check-$every.log" 2>&1
+    summary+=("cuda-fused 2048^2, stop rule every $every steps: wall $(median_of wall_ms /tmp/check-$every/manifest.json) ms for 400 steps, median step $(median_of median_step_ms /tmp/check-$every/manifest.json) ms")
   done
 fi
 

@@ -3,6 +3,8 @@
 // the registry's variants and the profiled passes. Against the CPU: tests/match.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <functional>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -103,17 +105,56 @@ TEST(CudaPipeline, VerletContinuesFromAGivenPreviousPosition) {
   }
 }
 
+// The stop rule's reduction runs inside the kernel that writes each step's result (update,
+// combine, fused): a non-finite node makes it NaN whichever kernel that is, on grids and on
+// general models.
 TEST(CudaPipeline, MaxDisplacementIsNanWhenTheStateIsNotFinite) {
   DEFORMLAB_REQUIRE_CUDA();
+  for (const bool general : {false, true}) {
+    const Model m = general ? as_general(make_model(kShapes[2])) : make_model(kShapes[2]);
+    State s = perturbed_state(m, 3u);
+    s.v[100].y = std::numeric_limits<float>::quiet_NaN();
+    for (Integrator i : kIntegrators)
+      for (Variant v : kVariants) {
+        auto g = cuda::make_pipeline({m, scene_params(), i}, options(v));
+        g->set_state(s);
+        EXPECT_EQ(g->max_displacement(), 0.0) << "no step yet";
+        g->step();
+        EXPECT_TRUE(std::isnan(g->max_displacement())) << name(v) << " " << info(i).name << " general " << general;
+      }
+  }
+}
+
+// Each step's largest displacement is its own and bitwise the CPU's, step after step, replayed
+// as graphs or launched pass by pass, on a damped cloth whose motion dies down at some step (so
+// a warp maximum left from an earlier step would show).
+TEST(CudaPipeline, MaxDisplacementIsEachStepsOwn) {
+  DEFORMLAB_REQUIRE_CUDA();
   const Model m = make_model(kShapes[2]);
-  State s = perturbed_state(m, 3u);
-  s.v[100].y = std::numeric_limits<float>::quiet_NaN();
-  for (Variant v : kVariants) {
-    auto g = cuda::make_pipeline({m, scene_params(), Integrator::semi_implicit_euler}, options(v));
-    g->set_state(s);
-    EXPECT_EQ(g->max_displacement(), 0.0) << "no step yet";
-    g->step();
-    EXPECT_TRUE(std::isnan(g->max_displacement())) << name(v);
+  Params p = scene_params();
+  p.gravity = p.wind = {};
+  p.damping = 2.f;
+  p.dt = 1e-4f;  // explicit Euler's fastest spring modes decay too
+  const State s0 = perturbed_state(m, 9u, 0.f);  // springs at rest, nodes moving
+  for (Integrator i : kIntegrators) {
+    auto cpu = make_cpu_pipeline({m, p, i}, Precision::f32, false);
+    cpu->set_state(s0);
+    std::vector<double> want;
+    for (int k = 0; k < kSteps; ++k) {
+      cpu->step();
+      want.push_back(cpu->max_displacement());
+    }
+    ASSERT_TRUE(std::adjacent_find(want.begin(), want.end(), std::greater<>()) != want.end())
+        << info(i).name << ": the motion must slow down at some step";
+    for (Variant v : {Variant::naive, Variant::tiled, Variant::fused})
+      for (const bool graphs : {true, false}) {
+        auto g = cuda::make_pipeline({m, p, i}, options(v, graphs));
+        g->set_state(s0);
+        for (int k = 0; k < kSteps; ++k) {
+          g->step();
+          EXPECT_EQ(g->max_displacement(), want[k]) << name(v) << " " << info(i).name << " step " << k + 1;
+        }
+      }
   }
 }
 
@@ -146,14 +187,18 @@ TEST(CudaPipeline, RefusesASizeThatDoesNotFit) {
   }
   const Model m = make_model(kShapes[4]);
   EXPECT_NO_THROW(cuda::require_device_memory(cuda::bytes_needed(m.size(), Integrator::rk4, {}), "a 256x256 cloth"));
-  // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers.
-  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::rk4, options(Variant::naive)), m.node_count() * 16 * (4 + 6 + 4));
-  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 4);
+  // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers; every
+  // pipeline the stop rule's warp maxima (a word per 32 nodes, room for tile padding).
+  const std::int64_t stop = (m.node_count() / 32 + 1024) * 8;
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::rk4, options(Variant::naive)),
+            m.node_count() * 16 * (4 + 6 + 4) + stop);
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 4 + stop);
   // Grids need no spring arrays, not even for scatter; a general model's adjacency or spring list adds its bytes.
-  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::scatter)), m.node_count() * 16 * 5);
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::scatter)),
+            m.node_count() * 16 * 5 + stop);
   const ModelSize g = explicit_springs(m).size();
   EXPECT_EQ(cuda::bytes_needed(g, Integrator::verlet, options(Variant::scatter)),
-            m.node_count() * 16 * 5 + g.springs * 20);
+            m.node_count() * 16 * 5 + stop + g.springs * 20);
 }
 
 // ---- no device needed ----

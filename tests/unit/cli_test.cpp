@@ -15,7 +15,7 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_NE(r.out.find("compare: largest position error"), std::string::npos) << r.out;
 
   const std::string csv = slurp(out / "timings.csv");
-  EXPECT_EQ(csv.rfind("step,t_s,step_ms,max_displacement_m\n", 0), 0u);
+  EXPECT_EQ(csv.rfind("step,t_s,step_ms,queue_ms,max_displacement_m\n", 0), 0u);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 11);
 
   const std::string ply = slurp(out / "state.ply");
@@ -29,6 +29,9 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_EQ(m["pipeline"], "cpu");
   EXPECT_EQ(m["integrator"], "verlet");
   EXPECT_EQ(m["result"]["steps"], 10);
+  EXPECT_EQ(m["result"]["step_clock"], "host clock");
+  EXPECT_GT(m["result"]["median_step_ms"].get<double>(), 0.0);
+  EXPECT_NE(r.out.find("ms/step (host clock), "), std::string::npos) << r.out;
   EXPECT_EQ(m["scene"]["model"]["size"], nlohmann::json::array({8, 6}));
   EXPECT_LT(m["compare"]["max_position_error_relative_to_extent"].get<double>(), 1e-5);
   EXPECT_TRUE(m["build"].contains("compiler"));
