@@ -30,7 +30,7 @@ class Pipeline {
   // the pipeline lives). The default: the host clock, for pipelines that step on the host.
   virtual std::unique_ptr<StepTimer> step_timer() { return std::make_unique<HostStepTimer>(); }
   // How the profiler's stage spans are timed ("host clock", "CUDA events", "GL timer queries").
-  virtual std::string timing_method() const { return "host clock (steady_clock)"; }
+  virtual std::string timing_method() const { return "host clock"; }
   // Pipelines that time their stages add spans (force, hand-off, update, ...) to `p` from
   // now on; null stops it. The default records nothing.
   virtual void set_profiler(Profiler* p) { (void)p; }
