@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/pipeline.hpp"
+#include "core/scene.hpp"
 
 namespace deformlab::bench {
 
@@ -23,6 +24,9 @@ struct BenchScene {
   Model model;
   Params params;
   PipelineSetup setup(Integrator i) const { return {model, params, i}; }
+
+ private:
+  explicit BenchScene(const Scene& s);
 };
 
 // Median and spread of a list of timings (ms).

@@ -1,4 +1,5 @@
 #include <iostream>
+#include <stdexcept>
 
 #include "bench.hpp"
 
@@ -19,6 +20,9 @@ int main(int argc, char** argv) {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return cli.exit(e) == 0 ? 0 : 2;
+  } catch (const std::invalid_argument& e) {  // bad input
+    std::cerr << "deformlab-bench: error: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "deformlab-bench: error: " << e.what() << "\n";
     return 1;

@@ -7,7 +7,6 @@
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
-#include "core/scene.hpp"
 #include "experiments/experiment.hpp"
 
 namespace deformlab::bench {
@@ -41,10 +40,9 @@ Scene scene_of(int n, SceneKind k) {
 }
 }  // namespace
 
-BenchScene::BenchScene(int n, SceneKind k) : model(build_model(scene_of(n, k))) {
-  params = resolve_params(scene_of(n, k), model);
-}
+BenchScene::BenchScene(int n, SceneKind k) : BenchScene(scene_of(n, k)) {}
 
+BenchScene::BenchScene(const Scene& s) : model(build_model(s)), params(resolve_params(s, model)) {}
 
 Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};
@@ -67,7 +65,8 @@ Integrator BenchOptions::integ() const {
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
-  c.add_option("--scene", o.scene, "Scene: paper (table2's) or idealised");
+  c.add_option("--scene", o.scene, "Scene: paper (table2's) or idealised")
+      ->check(CLI::IsMember({to_string(SceneKind::paper), to_string(SceneKind::idealised)}));
   c.add_option("--warmup", o.warmup, "Warm-up steps")->check(CLI::PositiveNumber);
   c.add_option("--integrator", o.integrator, "Integrator");
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");
