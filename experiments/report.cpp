@@ -105,18 +105,34 @@ void write_setup(Report& r) {
     if (status != "available") r.md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
 }
 
-// How the cells were timed, as the first measured cell says.
+// How the cells were timed, as the first measured cell says, and each step clock with the
+// pipelines it times.
 void write_method(Report& r) {
-  r.md << "- Method: ";
-  for (const auto& c : r.cells)
-    if (c["status"] == "ok") {
-      r.md << c["method"].get<std::string>() << ". "
-           << (r.sweep.time == "frame"
-                   ? "Times are milliseconds per frame (update and a 1024 x 1024 draw), as the paper's.\n"
-                   : "Times are milliseconds per simulation step (update only); the paper's are "
-                     "milliseconds per frame, update and rendering.\n");
-      break;
+  std::vector<std::pair<std::string, std::vector<std::string>>> clocks;
+  std::string method;
+  for (const auto& c : r.cells) {
+    if (c["status"] != "ok") continue;
+    if (method.empty()) method = c["method"].get<std::string>();
+    if (!c.contains("step_clock")) continue;
+    const std::string clock = c["step_clock"].get<std::string>(), p = c["pipeline"].get<std::string>();
+    auto it = std::find_if(clocks.begin(), clocks.end(), [&](const auto& e) { return e.first == clock; });
+    if (it == clocks.end()) it = clocks.insert(clocks.end(), {clock, {}});
+    if (std::find(it->second.begin(), it->second.end(), p) == it->second.end()) it->second.push_back(p);
+  }
+  if (method.empty()) return;
+  r.md << "- Method: " << method << ". "
+       << (r.sweep.time == "frame" ? "Times are milliseconds per frame (update and a 1024 x 1024 draw), as the paper's.\n"
+                                   : "Times are milliseconds per simulation step (update only); the paper's are "
+                                     "milliseconds per frame, update and rendering.\n");
+  if (!clocks.empty()) {
+    r.md << "- Step clocks:";
+    for (std::size_t k = 0; k < clocks.size(); ++k) {
+      r.md << (k ? ";" : "") << " " << clocks[k].first << " (";
+      for (std::size_t j = 0; j < clocks[k].second.size(); ++j) r.md << (j ? ", " : "") << clocks[k].second[j];
+      r.md << ")";
     }
+    r.md << "\n";
+  }
   r.md << "\n";
 }
 

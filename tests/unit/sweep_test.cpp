@@ -149,7 +149,8 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
                                                    .dump();
   auto cell = [&](const std::string& p, int n, double ms) {
     json c = {{"id", p + std::to_string(n)}, {"size", n}, {"pipeline", p}, {"integrator", "explicit-euler"},
-              {"options", json::object()}, {"nodes", n * n}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"}};
+              {"options", json::object()}, {"nodes", n * n}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"},
+              {"step_clock", p == "omp" ? "host clock" : "GL timer queries (GL_TIMESTAMP)"}};
     std::ofstream(dir_ / "cells" / (p + std::to_string(n) + ".json")) << c.dump();
   };
   cell("omp", 64, 10.0);
@@ -179,6 +180,12 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
             std::string::npos)
       << md;
   EXPECT_NE(md.find("[2] cut: too slow (glsl-tf 512²)"), std::string::npos) << md;
+  EXPECT_NE(md.find("- Method: fixed. "), std::string::npos) << md;
+  const std::size_t clocks = md.find("- Step clocks: ");
+  ASSERT_NE(clocks, std::string::npos) << md;
+  const std::string line = md.substr(clocks, md.find('\n', clocks) - clocks);
+  EXPECT_NE(line.find("host clock (omp)"), std::string::npos) << line;
+  EXPECT_NE(line.find("GL timer queries (GL_TIMESTAMP) (glsl-tf)"), std::string::npos) << line;
   EXPECT_NE(md.find("a/d (omp / glsl-tf) at 64²: paper 93.364, here 5.000: the paper's ordering holds"),
             std::string::npos)
       << md;
