@@ -106,16 +106,15 @@ std::string cut_after_second_step(CellSteps& steps, const Sweep& s) {
   return os.str();
 }
 
-// The rest of the warm-up, then ms per step of each timed batch: steps on the pipeline's
-// step clock; frames (a step and its draw) on the host clock, from a drained device to a
-// drained device.
-std::vector<double> timed_batches(Pipeline& pipe, CellSteps& steps, const Sweep& s) {
+// The rest of the warm-up, then ms per step of each timed batch: steps by `timer`, one of
+// the pipeline's step timers; frames (null timer: a step and its draw each) on the host clock,
+// from a drained device to a drained device.
+std::vector<double> timed_batches(Pipeline& pipe, StepTimer* timer, CellSteps& steps, const Sweep& s) {
   for (int w = kBoundingSteps; w < s.warmup; ++w) steps.step();
   steps.finish();
   std::vector<double> ms_per_step;
-  const auto timer = pipe.step_timer();
   for (int rep = 0; rep < s.repetitions; ++rep) {
-    if (s.time != "frame") {
+    if (timer) {
       const std::vector<double> ms = timed_steps(pipe, *timer, s.steps);
       ms_per_step.push_back(std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size()));
       continue;
@@ -160,7 +159,8 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
   pipe.set_state(rest_state(m));
   CellSteps steps(pipe, m, s.time);
   if (auto why = cut_after_second_step(steps, s); !why.empty()) return not_applicable(r, why);
-  const std::vector<double> ms = timed_batches(pipe, steps, s);
+  const std::unique_ptr<StepTimer> timer = s.time == "frame" ? nullptr : pipe.step_timer();
+  const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s);
   const double d = pipe.max_displacement();
   if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
   r["status"] = "ok";
@@ -171,7 +171,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
   r["pipeline_timing"] = pipe.timing_method();
   r["time"] = s.time;
   r["method"] = method_of(s);
-  if (s.time != "frame") r["step_clock"] = pipe.step_timer()->clock();
+  if (timer) r["step_clock"] = timer->clock();
   return r;
 }
 
