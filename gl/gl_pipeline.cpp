@@ -227,6 +227,8 @@ void GlPipeline::init() {
   }
   reduce_ = gl::make_program({{GL_COMPUTE_SHADER, "reduce.comp"}});
   reduce_n_ = uniform(reduce_.id(), "u_n");
+  reduce_stride_ = uniform(reduce_.id(), "u_stride");
+  reduce_word_ = uniform(reduce_.id(), "u_word");
   copy_ = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   copy_n_ = uniform(copy_.id(), "u_n");
   check(name_ + " setup");
@@ -364,6 +366,7 @@ void GlPipeline::update(const Pass& pass) {
   } else {
     io.out = {&x_[d], &v_[d], &xp_[d]};
     io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
+    io.result = true;
   }
   if (shared_) io.forces_acc = &forces_acc_;
   run_pass(id, io);
@@ -398,11 +401,12 @@ double GlPipeline::max_displacement() {
   glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, 4, &zero);
   glUseProgram(reduce_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
-  for (const NodeWindow& w : windows_) {
-    glUniform1i(reduce_n_, w.count);
-    bind_nodes(0, v_[cur_], w.first, w.count);
-    glDispatchCompute(GLuint(std::min(1024, (w.count + 255) / 256)), 1, 1);
-  }
+  bind_terms([&](int count, int stride, int word) {
+    glUniform1i(reduce_n_, count);
+    glUniform1i(reduce_stride_, stride);
+    glUniform1i(reduce_word_, word);
+    glDispatchCompute(GLuint(std::min(1024, (count + 255) / 256)), 1, 1);
+  });
   std::uint32_t bits = 0;
   read_buffer(result_.id(), 0, 4, &bits);
   glUseProgram(0);
@@ -410,6 +414,13 @@ double GlPipeline::max_displacement() {
   float d;
   std::memcpy(&d, &bits, 4);
   return std::isfinite(d) ? double(d) : std::numeric_limits<double>::quiet_NaN();
+}
+
+void GlPipeline::bind_terms(const std::function<void(int count, int stride, int word)>& reduce) {
+  for (const NodeWindow& w : windows_) {
+    bind_nodes(0, v_[cur_], w.first, w.count);
+    reduce(w.count, 4, 3);
+  }
 }
 
 GLuint GlPipeline::position_buffer() {

@@ -85,6 +85,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     std::array<const NodeBuffer*, 3> out;
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
+    bool result;                   // it writes the step's result (and its stop-rule terms)
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
@@ -104,6 +105,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
   virtual void on_set_state() {}
+  // Binds the last step's stop-rule terms (32-bit words, a float's bits) to storage binding 0,
+  // a range at a time, calling reduce(count, stride, word) after each: the terms are words
+  // word, word + stride, ... By default the w of the current velocities, window by window.
+  virtual void bind_terms(const std::function<void(int count, int stride, int word)>& reduce);
 
   int n_ = 0;
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
@@ -142,7 +147,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   Buffer params_ubo_, adj_offset_, links_, result_;
   Texture adj_offset_tex_, links_tex_;
   Program reduce_, copy_;
-  GLint reduce_n_ = -1, copy_n_ = -1;
+  GLint reduce_n_ = -1, reduce_stride_ = -1, reduce_word_ = -1, copy_n_ = -1;
   std::int64_t max_texels_ = 0, max_block_nodes_ = 0;
   Profiler* prof_ = nullptr;
   TimerSpans spans_;  // the profiled steps

@@ -25,21 +25,43 @@ vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 
 #include "sim.glsl"
 
+#if PASS != PASS_STAGE
+// The stop rule's reduction in the pass that writes the step's result: each work group stores
+// the largest term of its nodes (o1.w, non-negative, +inf where not finite) as float bits,
+// which order as the floats do; GlPipeline reduces the groups' values when asked.
+layout(std430, binding = 9) writeonly buffer GroupMax { uint group_max[]; };
+layout(location = 3) uniform int u_group_base;  // this dispatch's first slot in group_max
+shared uint group_term;
+#endif
+
 void main() {
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
   int l = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
-  if (l >= u_count) return;
-  int i = u_first + l, r = i - u_read_first;
-#if PASS == PASS_ONE && RULE == RULE_VERLET
-  vec4 xp = s0_p[r];
-#else
-  vec4 xp = vec4(0.0);
+#if PASS != PASS_STAGE
+  if (gl_LocalInvocationIndex == 0u) group_term = 0u;
+  barrier();  // every invocation reaches the barriers: none returns early
 #endif
-  vec4 o0, o1, o2;
-  node_pass(i, s0_x[r], s0_v[r], xp, o0, o1, o2);
-  out0[l] = o0;
-  out1[l] = o1;
+  if (l < u_count) {
+    int i = u_first + l, r = i - u_read_first;
+#if PASS == PASS_ONE && RULE == RULE_VERLET
+    vec4 xp = s0_p[r];
+#else
+    vec4 xp = vec4(0.0);
+#endif
+    vec4 o0, o1, o2;
+    node_pass(i, s0_x[r], s0_v[r], xp, o0, o1, o2);
+    out0[l] = o0;
+    out1[l] = o1;
 #if PASS == PASS_STAGE || (PASS == PASS_ONE && RULE == RULE_VERLET)
-  out2[l] = o2;
+    out2[l] = o2;
+#endif
+#if PASS != PASS_STAGE
+    atomicMax(group_term, floatBitsToUint(o1.w));
+#endif
+  }
+#if PASS != PASS_STAGE
+  barrier();
+  if (gl_LocalInvocationIndex == 0u)
+    group_max[u_group_base + int(gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x)] = group_term;
 #endif
 }
