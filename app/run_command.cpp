@@ -122,7 +122,8 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"options", in.options},
       {"scene", to_json(in.x.scene)},
       {"model", {{"nodes", in.model.node_count()}, {"springs", in.model.spring_count()},
-                 {"drag_node", in.params.drag.node},
+                 {"drag_node", in.params.drag.active() ? in.model.file_index(in.params.drag.node) : -1},
+                 {"repairs", in.model.repairs}, {"bandwidth", bandwidth(in.model)},
                  {"stability_limit_s", stability_limit(in.model, in.params, in.integ)},
                  {"host_bytes", in.model.host_bytes()}}},
       {"memory", memory_of(in)},
@@ -150,11 +151,10 @@ void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r,
                    const Profiler& profiler, const StepMedians& med, const json& compare, const OutputDir& dir,
                    double setup_s) {
   const Model& m = in.model;
-  const bool lattice = m.topology == Topology::lattice;
   std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name) << " on " << in.entry->name << " ("
-            << info(in.integ).name << "), " << (lattice ? "lattice " : "cloth ") << m.nx << "x" << m.ny;
-  if (lattice) std::cout << "x" << m.nz;
-  std::cout << ": " << m.node_count() << " nodes, " << m.spring_count() << " springs\n";
+            << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
+            << m.spring_count() << " springs\n";
+  for (const auto& line : m.repairs) std::cout << "  mesh: " << line << "\n";
   std::cout << "  steps: " << r.steps << " (" << r.steps * double(in.params.dt) << " s simulated); ";
   if (in.until_converged)
     std::cout << (r.converged ? "converged: no node moved more than " : "not converged within max_steps; threshold ")

@@ -7,6 +7,7 @@
 
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
+#include "mesh/scene_model.hpp"
 #if DEFORMLAB_GL_RENDER
 #include "gl/context.hpp"
 #endif
@@ -101,8 +102,8 @@ void apply_param_flags(const RunArgs& a, Params& p) {
 }
 
 // Refuses a run whose host memory does not fit before anything is allocated.
-void check_fits(const RunInput& in, bool compare) {
-  const std::string why = host_memory_shortfall(model_size(in.x.scene.model), *in.entry, in.integ, in.options,
+void check_fits(const RunInput& in, bool compare, const ModelSize& size) {
+  const std::string why = host_memory_shortfall(size, *in.entry, in.integ, in.options,
                                                 compare ? pipelines().find("reference") : nullptr);
   if (!why.empty()) throw BadInput(why);
 }
@@ -122,9 +123,12 @@ RunInput read_run_input(const RunArgs& a) {
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   if (a.compare && *a.compare != "cpu")
     throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
-  check_fits(in, bool(a.compare));
+  // A grid is counted before it is built; a mesh once it is read.
+  const bool mesh = in.x.scene.model.topology == Topology::general;
+  if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
   const auto t0 = std::chrono::steady_clock::now();
   in.model = build_model(in.x.scene);
+  if (mesh) check_fits(in, bool(a.compare), in.model.size());
   in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);
   return in;

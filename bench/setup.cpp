@@ -8,6 +8,7 @@
 #include "bench.hpp"
 #include "core/profiler.hpp"
 #include "experiments/experiment.hpp"
+#include "mesh/scene_model.hpp"
 
 namespace deformlab::bench {
 

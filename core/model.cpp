@@ -46,7 +46,7 @@ std::int64_t Model::host_bytes() const {
   auto bytes = [](const auto& v) { return std::int64_t(v.capacity() * sizeof(v[0])); };
   return bytes(rest_position) + bytes(inv_mass) + bytes(spring_i) + bytes(spring_j) + bytes(rest_length) +
          bytes(kind) + bytes(spring_stiffness) + bytes(spring_damping) + bytes(adj_offset) + bytes(adj_spring) +
-         bytes(adj_node);
+         bytes(adj_node) + bytes(triangle) + bytes(file_node);
 }
 
 float Model::extent() const {
@@ -129,7 +129,57 @@ std::array<std::int64_t, kSpringKinds> lattice_spring_counts(std::int64_t nx, st
   return {structural, face + body, flexion};
 }
 
-std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& explicit_nodes) {
+std::vector<int> select_nodes(const Model& m, const NodeSelector& s) {
+  const int n = m.node_count();
+  std::vector<int> out;
+  using K = NodeSelector::Kind;
+  switch (s.kind) {
+    case K::index: {
+      if (s.index < 0 || s.index >= n)
+        throw std::invalid_argument("node " + std::to_string(s.index) + " is outside the model (0.." +
+                                    std::to_string(n - 1) + ")");
+      int v = s.index;
+      if (!m.file_node.empty()) v = int(std::find(m.file_node.begin(), m.file_node.end(), s.index) - m.file_node.begin());
+      return {v};
+    }
+    case K::box:
+    case K::below:
+      for (int v = 0; v < n; ++v) {
+        const Vec3f& p = m.rest_position[v];
+        const bool in = s.kind == K::box ? (p.x >= s.a.x && p.y >= s.a.y && p.z >= s.a.z && p.x <= s.b.x &&
+                                            p.y <= s.b.y && p.z <= s.b.z)
+                                         : dot(p - s.a, s.b) <= 0.f;
+        if (in) out.push_back(v);
+      }
+      if (out.empty())
+        throw std::invalid_argument(std::string(s.kind == K::box ? "the box" : "the half-space below the plane") +
+                                    " holds no node of the model");
+      return out;
+    case K::center:
+      if (m.grid()) return {((m.nz / 2) * m.ny + m.ny / 2) * m.nx + m.nx / 2};
+      [[fallthrough]];
+    case K::nearest: {
+      Vec3f target = s.a;
+      if (s.kind == K::center) {
+        Vec3f lo = m.rest_position[0], hi = lo;
+        for (const auto& p : m.rest_position)
+          for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+        target = (lo + hi) * 0.5f;
+      }
+      // Ties go to the lowest index in the file, so the pick does not depend on node order.
+      int best = 0;
+      double best_d = INFINITY;
+      for (int v = 0; v < n; ++v) {
+        const double d = norm(Vec3d(m.rest_position[v] - target));
+        if (d < best_d || (d == best_d && m.file_index(v) < m.file_index(best))) { best = v; best_d = d; }
+      }
+      return {best};
+    }
+  }
+  return out;
+}
+
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list) {
   std::vector<int> out;
   const bool grid = m.topology != Topology::general;
   // "top": cloth row j = 0; lattice layer j = ny-1 (front row k = 0 for corners / row).
@@ -138,21 +188,20 @@ std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& e
   switch (set) {
     case PinSet::none: break;
     case PinSet::top_corners:
-      if (!grid) throw std::invalid_argument("pin set 'top-corners' needs a grid or lattice");
+      if (!grid) throw std::invalid_argument("pin set 'top-corners' needs a grid or lattice (pin meshes by position)");
       out.push_back(node(0, top_j, 0));
       if (m.nx > 1) out.push_back(node(m.nx - 1, top_j, 0));
       break;
     case PinSet::top_row:
-      if (!grid) throw std::invalid_argument("pin set 'top-row' needs a grid or lattice");
+      if (!grid) throw std::invalid_argument("pin set 'top-row' needs a grid or lattice (pin meshes by position)");
       for (int i = 0; i < m.nx; ++i) out.push_back(node(i, top_j, 0));
       break;
     case PinSet::list:
-      for (int v : explicit_nodes) {
-        if (v < 0 || v >= m.node_count())
-          throw std::invalid_argument("pinned node " + std::to_string(v) + " is outside the model (0.." +
-                                      std::to_string(m.node_count() - 1) + ")");
-        out.push_back(v);
-      }
+      for (std::size_t k = 0; k < list.size(); ++k) try {
+          for (int v : select_nodes(m, list[k])) out.push_back(v);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument("pins[" + std::to_string(k) + "]: " + e.what());
+        }
       break;
   }
   return out;

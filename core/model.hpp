@@ -49,6 +49,11 @@ struct Model {
   // adj_offset[v+1]), adj_node holds the spring's other end. [n+1], [2s], [2s].
   std::vector<std::int32_t> adj_offset, adj_spring, adj_node;
 
+  // Models from mesh files (empty otherwise):
+  std::vector<std::int32_t> triangle;   // [3t] surface triangles (a volume's boundary), for drawing
+  std::vector<std::int32_t> file_node;  // [n] or empty: node v is node file_node[v] of the mesh as loaded
+  std::vector<std::string> repairs;     // what loading repaired, a line each ("welded 12 duplicate vertices")
+
   int node_count() const { return int(rest_position.size()); }
   std::int64_t spring_count() const;  // grids: in closed form
   bool pinned(int v) const { return inv_mass[v] == 0.f; }
@@ -59,6 +64,8 @@ struct Model {
   float spring_kd(int e) const { return spring_damping.empty() ? damping[int(kind[e])] : spring_damping[e]; }
   // Recomputes adj_* from spring_i/j (ordered by spring index within each node).
   void build_adjacency();
+  // Node v's index in the mesh as loaded (v itself unless the nodes were reordered).
+  int file_index(int v) const { return file_node.empty() ? v : file_node[v]; }
   // Largest distance between two rest positions' bounding-box corners.
   float extent() const;
   ModelSize size() const { return {node_count(), spring_count(), grid()}; }
@@ -87,9 +94,25 @@ std::array<std::int64_t, kSpringKinds> cloth_spring_counts(std::int64_t nx, std:
 std::array<std::int64_t, kSpringKinds> lattice_spring_counts(std::int64_t nx, std::int64_t ny,
                                                              std::int64_t nz);
 
+// Nodes named in a scene: by index (in the file's order for meshes), or by position so that
+// one scene fits any mesh: every node inside a box, every node on or below a plane, the node
+// nearest a point, or the centre (a grid's middle node; else the node nearest the middle of
+// the rest shape's bounding box).
+struct NodeSelector {
+  enum class Kind : std::uint8_t { index, box, below, nearest, center } kind = Kind::index;
+  int index = -1;
+  Vec3f a{}, b{};  // box: lowest and highest corner; below: a point of the plane and its upward normal; nearest: a
+  static NodeSelector node(int v) { return {Kind::index, v}; }
+  bool single() const { return kind == Kind::index || kind == Kind::nearest || kind == Kind::center; }
+};
+// The model's nodes a selector picks, in ascending order (model numbering); throws
+// std::invalid_argument when an index is outside the model or a selector picks nothing.
+std::vector<int> select_nodes(const Model& m, const NodeSelector& s);
+
 enum class PinSet : std::uint8_t { none, top_corners, top_row, list };
-// Nodes of a pin set on a grid or lattice model (list: returns `explicit_nodes`, checked).
-std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<int>& explicit_nodes);
+// Nodes of a pin set: top corners / top row of a grid or lattice, or every node the list's
+// selectors pick.
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list);
 void pin(Model& m, const std::vector<int>& nodes);
 
 // Rest length of a grid's springs along offset o: spacing x |o|.

@@ -1,6 +1,7 @@
 #include "scene.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -65,14 +66,134 @@ void per_kind(std::array<float, kSpringKinds>& out, const json& j, const std::st
   }
 }
 
-void apply_model(ModelSpec& m, const json& j, const std::string& where) {
-  only_keys(j, where, {"type", "size", "spacing", "width", "height", "node_mass", "stiffness", "damping", "pins"});
+// A node selector: an index, "center" (when allowed), or {"box": [lo, hi]}, {"below": {"point":
+// p, "normal": n}}, {"nearest": p}.
+NodeSelector selector(const json& j, const std::string& where, bool center) {
+  using K = NodeSelector::Kind;
+  const char* expected = center ? "expected a node index, \"center\" or {\"nearest\": [x, y, z]}"
+                                : "expected a node index or one of {\"box\": ...}, {\"below\": ...}, {\"nearest\": ...}";
+  if (j.is_number_integer()) return NodeSelector::node(integer(j, where, 0));
+  if (center && j == "center") return {K::center};
+  if (!j.is_object() || j.size() != 1) bad(where, expected);
+  NodeSelector s;
+  if (j.contains("nearest")) {
+    s = {K::nearest, -1, vec3(j["nearest"], where + ".nearest")};
+  } else if (center) {
+    bad(where, expected);  // a drag handle holds one node
+  } else if (j.contains("box")) {
+    const auto& b = j["box"];
+    if (!b.is_array() || b.size() != 2) bad(where + ".box", "expected [[x0, y0, z0], [x1, y1, z1]]");
+    s = {K::box, -1, vec3(b[0], where + ".box[0]"), vec3(b[1], where + ".box[1]")};
+    for (int c = 0; c < 3; ++c)
+      if (s.a[c] > s.b[c]) bad(where + ".box", "the first corner must be the lowest in x, y and z");
+  } else if (j.contains("below")) {
+    only_keys(j["below"], where + ".below", {"point", "normal"});
+    if (!j["below"].contains("point") || !j["below"].contains("normal")) bad(where + ".below", "needs point and normal");
+    s = {K::below, -1, vec3(j["below"]["point"], where + ".below.point"), vec3(j["below"]["normal"], where + ".below.normal")};
+    if (norm(s.b) == 0.f) bad(where + ".below.normal", "expected a non-zero vector");
+  } else {
+    bad(where, expected);
+  }
+  return s;
+}
+
+json to_json(const NodeSelector& s) {
+  auto v3 = [](const Vec3f& v) { return json::array({v.x, v.y, v.z}); };
+  using K = NodeSelector::Kind;
+  switch (s.kind) {
+    case K::index: return s.index;
+    case K::center: return "center";
+    case K::nearest: return {{"nearest", v3(s.a)}};
+    case K::box: return {{"box", {v3(s.a), v3(s.b)}}};
+    case K::below: return {{"below", {{"point", v3(s.a)}, {"normal", v3(s.b)}}}};
+  }
+  return nullptr;
+}
+
+// "transform": {"rotate": [deg about x, y, z], "translate": [x, y, z]} (x first, then y, then
+// z, then the translation), or the matrix's rows (3 or 4 rows of 4; a 4th row is 0 0 0 1).
+std::array<float, 12> transform(const json& j, const std::string& where) {
+  std::array<float, 12> t{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  if (j.is_array()) {
+    if (j.size() != 3 && j.size() != 4) bad(where, "expected 3 or 4 rows of 4 numbers");
+    for (std::size_t r = 0; r < j.size(); ++r) {
+      const std::string w = where + "[" + std::to_string(r) + "]";
+      if (!j[r].is_array() || j[r].size() != 4) bad(w, "expected a row of 4 numbers");
+      for (int c = 0; c < 4; ++c) {
+        const float v = num(j[r][c], w + "[" + std::to_string(c) + "]");
+        if (r < 3) t[r * 4 + c] = v;
+        else if (v != (c == 3 ? 1.f : 0.f)) bad(w, "the last row of an affine map is [0, 0, 0, 1]");
+      }
+    }
+    return t;
+  }
+  only_keys(j, where, {"rotate", "translate"});
+  if (j.contains("rotate")) {
+    const Vec3f deg = vec3(j["rotate"], where + ".rotate");
+    std::array<double, 9> r{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    for (int axis = 0; axis < 3; ++axis) {  // r = R_axis * r
+      const double a = double(deg[axis]) * M_PI / 180.0, c = std::cos(a), sn = std::sin(a);
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int col = 0; col < 3; ++col) {
+        const double ru = r[u * 3 + col], rv = r[v * 3 + col];
+        r[u * 3 + col] = c * ru - sn * rv;
+        r[v * 3 + col] = sn * ru + c * rv;
+      }
+    }
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 3; ++col) t[row * 4 + col] = float(r[row * 3 + col]);
+  }
+  if (j.contains("translate")) {
+    const Vec3f d = vec3(j["translate"], where + ".translate");
+    for (int row = 0; row < 3; ++row) t[row * 4 + 3] = d[row];
+  }
+  return t;
+}
+
+void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std::string& dir) {
+  if (j.contains("file")) {
+    if (!j["file"].is_string() || j["file"].get<std::string>().empty()) bad(where + ".file", "expected a file name");
+    const std::filesystem::path f = j["file"].get<std::string>();
+    m.file = (f.is_relative() && !dir.empty() ? std::filesystem::path(dir) / f : f).lexically_normal().string();
+  }
+  if (j.contains("scale")) {
+    if (j["scale"].is_number()) m.scale = Vec3f{1.f, 1.f, 1.f} * num(j["scale"], where + ".scale", Range::positive);
+    else m.scale = vec3(j["scale"], where + ".scale");
+    for (int c = 0; c < 3; ++c)
+      if (!(m.scale[c] > 0.f)) bad(where + ".scale", "expected scale factors > 0");
+  }
+  if (j.contains("transform")) m.transform = transform(j["transform"], where + ".transform");
+  if (j.contains("density")) m.density = num(j["density"], where + ".density", Range::positive);
+  if (j.contains("fill")) {
+    if (j["fill"] == "tetrahedra") m.fill = true;
+    else if (j["fill"] == "none") m.fill = false;
+    else bad(where + ".fill", "expected \"tetrahedra\" or \"none\"");
+  }
+  if (j.contains("cell_size")) m.cell_size = num(j["cell_size"], where + ".cell_size", Range::non_negative);
+  if (j.contains("order")) {
+    const auto o = parse_node_order(j["order"].is_string() ? j["order"].get<std::string>() : "");
+    if (!o) bad(where + ".order", std::string("expected one of: ") + kNodeOrderNames);
+    m.order = *o;
+  }
+  if (j.contains("seed")) m.seed = std::uint64_t(integer(j["seed"], where + ".seed", 0));
+}
+
+void apply_model(ModelSpec& m, const json& j, const std::string& where, const std::string& dir) {
+  only_keys(j, where, {"type", "size", "spacing", "width", "height", "file", "scale", "transform", "density", "fill",
+                       "cell_size", "order", "seed", "node_mass", "stiffness", "damping", "pins"});
   if (j.contains("type")) {
     const auto t = j["type"].is_string() ? j["type"].get<std::string>() : "";
     if (t == "cloth") m.topology = Topology::cloth_grid;
     else if (t == "lattice") m.topology = Topology::lattice;
-    else bad(where + ".type", "expected \"cloth\" or \"lattice\"");
+    else if (t == "mesh") m.topology = Topology::general;
+    else bad(where + ".type", "expected \"cloth\", \"lattice\" or \"mesh\"");
   }
+  const bool mesh = m.topology == Topology::general;
+  for (const char* k : {"size", "spacing", "width", "height"})
+    if (mesh && j.contains(k)) bad(where + "." + k, "not a key of a mesh model (its size comes from the file)");
+  for (const char* k : {"file", "scale", "transform", "density", "fill", "cell_size", "order", "seed"})
+    if (!mesh && j.contains(k)) bad(where + "." + k, "a key of mesh models (\"type\": \"mesh\")");
+  if (mesh) apply_mesh(m.mesh, j, where, dir);
   if (j.contains("size")) {
     const auto& s = j["size"];
     const std::size_t want = m.topology == Topology::lattice ? 3 : 2;
@@ -90,22 +211,23 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where) {
   if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
     const auto& p = j["pins"];
-    if (p.is_array()) {
+    if (p.is_array() || p.is_object()) {
       m.pins = PinSet::list;
       m.pin_list.clear();
+      const json list = p.is_array() ? p : json::array({p});
       std::set<int> seen;
-      for (std::size_t k = 0; k < p.size(); ++k) {
-        const std::string w = where + ".pins[" + std::to_string(k) + "]";
-        const int node = integer(p[k], w, 0);
-        if (!seen.insert(node).second) bad(w, "node " + std::to_string(node) + " is listed twice");
-        m.pin_list.push_back(node);
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const std::string w = where + ".pins" + (p.is_array() ? "[" + std::to_string(k) + "]" : "");
+        m.pin_list.push_back(selector(list[k], w, false));
+        const int node = m.pin_list.back().index;
+        if (node >= 0 && !seen.insert(node).second) bad(w, "node " + std::to_string(node) + " is listed twice");
       }
     } else {
       const auto s = p.is_string() ? p.get<std::string>() : "";
       if (s == "none") m.pins = PinSet::none;
       else if (s == "top-corners") m.pins = PinSet::top_corners;
       else if (s == "top-row") m.pins = PinSet::top_row;
-      else bad(where + ".pins", "expected \"none\", \"top-corners\", \"top-row\" or a list of node indices");
+      else bad(where + ".pins", "expected \"none\", \"top-corners\", \"top-row\", a selector or a list of node indices and selectors");
     }
   }
 }
@@ -115,10 +237,7 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
   DragSpec& d = s.drag;
   DragHandle& h = s.params.drag;
   d.enabled = true;
-  if (j.contains("node")) {
-    if (j["node"] == "center") { d.center = true; d.node = -1; }
-    else { d.center = false; d.node = integer(j["node"], where + ".node", 0); }
-  }
+  if (j.contains("node")) d.node = selector(j["node"], where + ".node", true);
   if (j.contains("mode")) {
     if (j["mode"] == "hard") h.as_spring = false;
     else if (j["mode"] == "spring") h.as_spring = true;
@@ -145,11 +264,11 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
 
 }  // namespace
 
-void apply_json(Scene& s, const json& j, const std::string& where) {
+void apply_json(Scene& s, const json& j, const std::string& where, const std::string& dir) {
   only_keys(j, where, {"model", "dt", "gravity", "damping", "wind", "ground", "spheres", "drag", "threshold",
                        "min_steps", "max_steps", "check_every", "runaway_factor"});
   Params& p = s.params;
-  if (j.contains("model")) apply_model(s.model, j["model"], where + ".model");
+  if (j.contains("model")) apply_model(s.model, j["model"], where + ".model", dir);
   if (j.contains("dt")) p.dt = num(j["dt"], where + ".dt", Range::positive);
   if (j.contains("gravity")) p.gravity = vec3(j["gravity"], where + ".gravity");
   if (j.contains("damping")) p.damping = num(j["damping"], where + ".damping", Range::non_negative);
@@ -186,30 +305,19 @@ void apply_json(Scene& s, const json& j, const std::string& where) {
 
 Scene load_scene(const std::string& path) {
   Scene s;
-  apply_json(s, read_json_file(path, "scene file"), path);
+  apply_json(s, read_json_file(path, "scene file"), path, std::filesystem::path(path).parent_path().string());
   return s;
-}
-
-Model build_model(const Scene& s) {
-  const ModelSpec& m = s.model;
-  if (m.nx < 1 || m.ny < 1 || m.nz < 1)
-    throw std::invalid_argument("model size must be positive in every dimension");
-  float h = m.spacing;
-  if (h == 0.f) h = m.nx > 1 ? m.width / float(m.nx - 1) : m.width;
-  Model model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
-                                                : cloth_grid(m.nx, m.ny, h, m.height, m.material);
-  pin(model, pin_nodes(model, m.pins, m.pin_list));
-  return model;
 }
 
 Params resolve_params(const Scene& s, const Model& m) {
   Params p = s.params;
   if (s.drag.enabled) {
-    int node = s.drag.node;
-    if (s.drag.center) node = ((m.nz / 2) * m.ny + m.ny / 2) * m.nx + m.nx / 2;
-    if (node < 0 || node >= m.node_count())
-      throw std::invalid_argument("drag node " + std::to_string(node) + " is outside the model (0.." +
-                                  std::to_string(m.node_count() - 1) + ")");
+    int node = -1;
+    try {
+      node = select_nodes(m, s.drag.node).at(0);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("drag ") + e.what());
+    }
     p.drag.node = node;
     if (s.drag.offsets)
       for (auto& k : p.drag.path) k.position = m.rest_position[node] + k.position;
@@ -220,6 +328,16 @@ Params resolve_params(const Scene& s, const Model& m) {
   return p;
 }
 
+std::string describe(const ModelSpec& m) {
+  switch (m.topology) {
+    case Topology::cloth_grid: return "cloth " + std::to_string(m.nx) + "x" + std::to_string(m.ny);
+    case Topology::lattice:
+      return "lattice " + std::to_string(m.nx) + "x" + std::to_string(m.ny) + "x" + std::to_string(m.nz);
+    case Topology::general: break;
+  }
+  return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + ", order " + to_string(m.mesh.order);
+}
+
 json to_json(const Scene& s) {
   auto v3 = [](const Vec3f& v) { return json::array({v.x, v.y, v.z}); };
   auto kinds = [](const std::array<float, kSpringKinds>& a) {
@@ -227,16 +345,29 @@ json to_json(const Scene& s) {
   };
   const ModelSpec& m = s.model;
   const Params& p = s.params;
-  json model{{"type", m.topology == Topology::lattice ? "lattice" : "cloth"},
-             {"spacing", m.spacing}, {"width", m.width}, {"height", m.height},
-             {"node_mass", m.material.node_mass}, {"stiffness", kinds(m.material.stiffness)},
+  json model{{"node_mass", m.material.node_mass}, {"stiffness", kinds(m.material.stiffness)},
              {"damping", kinds(m.material.damping)}};
-  model["size"] = m.topology == Topology::lattice ? json::array({m.nx, m.ny, m.nz}) : json::array({m.nx, m.ny});
+  if (m.topology == Topology::general) {
+    const MeshSpec& ms = m.mesh;
+    json rows = json::array();
+    for (int r = 0; r < 3; ++r) rows.push_back({ms.transform[r * 4], ms.transform[r * 4 + 1], ms.transform[r * 4 + 2], ms.transform[r * 4 + 3]});
+    model.update({{"type", "mesh"}, {"file", ms.file}, {"scale", v3(ms.scale)}, {"transform", rows},
+                  {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size},
+                  {"order", to_string(ms.order)}, {"seed", ms.seed}});
+    if (ms.density > 0) model["density"] = ms.density;
+  } else {
+    model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"spacing", m.spacing},
+                  {"width", m.width}, {"height", m.height}});
+    model["size"] = m.topology == Topology::lattice ? json::array({m.nx, m.ny, m.nz}) : json::array({m.nx, m.ny});
+  }
   switch (m.pins) {
     case PinSet::none: model["pins"] = "none"; break;
     case PinSet::top_corners: model["pins"] = "top-corners"; break;
     case PinSet::top_row: model["pins"] = "top-row"; break;
-    case PinSet::list: model["pins"] = m.pin_list; break;
+    case PinSet::list:
+      model["pins"] = json::array();
+      for (const auto& sel : m.pin_list) model["pins"].push_back(to_json(sel));
+      break;
   }
   json j{{"model", model}, {"dt", p.dt}, {"gravity", v3(p.gravity)}, {"damping", p.damping},
          {"wind", v3(p.wind)}, {"threshold", p.threshold}, {"min_steps", p.min_steps},
@@ -247,7 +378,7 @@ json to_json(const Scene& s) {
   if (s.drag.enabled) {
     json path = json::array();
     for (const auto& k : p.drag.path) path.push_back({k.t, k.position.x, k.position.y, k.position.z});
-    j["drag"] = {{"node", s.drag.center ? json("center") : json(s.drag.node)},
+    j["drag"] = {{"node", to_json(s.drag.node)},
                  {"mode", p.drag.as_spring ? "spring" : "hard"}, {"stiffness", p.drag.stiffness},
                  {"path_is", s.drag.offsets ? "offset" : "position"}, {"path", path}};
   } else {

@@ -6,26 +6,40 @@
 #include <vector>
 
 #include "model.hpp"
+#include "node_order.hpp"
 #include "params.hpp"
 
 namespace deformlab {
 
+// A model read from a mesh file (ModelSpec::topology general).
+struct MeshSpec {
+  std::string file;  // OBJ, PLY, STL, glTF (surfaces) or Gmsh .msh (volumes); relative to the scene file
+  Vec3f scale{1.f, 1.f, 1.f};
+  // Row-major affine map applied after the scale (the last row is 0 0 0 1).
+  std::array<float, 12> transform{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  float density = 0.f;      // kg/m^2 (surfaces) or kg/m^3 (volumes); 0: node_mass for every node
+  bool fill = false;        // fill a closed surface with tetrahedra
+  float cell_size = 0.f;    // fill: largest tetrahedron edge, m (0: what the surface gives)
+  NodeOrder order = NodeOrder::file;
+  std::uint64_t seed = 1;   // order "shuffled"
+};
+
 struct ModelSpec {
-  Topology topology = Topology::cloth_grid;
+  Topology topology = Topology::cloth_grid;  // general: a mesh file
   int nx = 128, ny = 128, nz = 1;
   float spacing = 0.f;  // 0: derived from `width` (cloth: width / (nx - 1))
   float width = 1.f;    // m, along x
   float height = 1.f;   // m, y of the cloth plane / bottom of the lattice
+  MeshSpec mesh;
   Material material;
   PinSet pins = PinSet::top_corners;
-  std::vector<int> pin_list;
+  std::vector<NodeSelector> pin_list;
 };
 
-// How a drag node is named in a file: an index, or "center" (resolved once the model exists).
+// The drag node: an index, "center" or the node nearest a point (resolved once the model exists).
 struct DragSpec {
   bool enabled = false;
-  bool center = false;
-  int node = -1;
+  NodeSelector node = {NodeSelector::Kind::index, -1};
   bool offsets = true;  // path positions are offsets from the node's rest position
 };
 
@@ -35,16 +49,19 @@ struct Scene {
   DragSpec drag;
 };
 
-// Fills `scene` from a JSON object (keys absent keep their current values).
-void apply_json(Scene& scene, const nlohmann::json& j, const std::string& where);
+// Fills `scene` from a JSON object (keys absent keep their current values). A relative mesh
+// file is taken relative to `dir` (the folder of the file that names it).
+void apply_json(Scene& scene, const nlohmann::json& j, const std::string& where, const std::string& dir = "");
 // Reads a scene file; throws std::invalid_argument with the file name and the problem.
 Scene load_scene(const std::string& path);
 
-// Builds the model (with pins) and resolves the drag node and path; throws
-// std::invalid_argument for sizes or settings that cannot be built.
-Model build_model(const Scene& s);
+// The scene's Params for a built model (mesh/scene_model.hpp builds it): the drag node and its
+// path resolved; throws std::invalid_argument for settings that do not fit the model.
 Params resolve_params(const Scene& s, const Model& m);
 
 nlohmann::json to_json(const Scene& s);
+
+// "cloth 128x128", "lattice 8x8x8", "mesh data/bunny.ply filled with tetrahedra, order rcm"
+std::string describe(const ModelSpec& m);
 
 }  // namespace deformlab

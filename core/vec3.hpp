@@ -34,6 +34,9 @@ template <class T> DL_HD bool operator==(const Vec3<T>& a, const Vec3<T>& b) {
   return a.x == b.x && a.y == b.y && a.z == b.z;
 }
 template <class T> DL_HD T dot(const Vec3<T>& a, const Vec3<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class T> DL_HD Vec3<T> cross(const Vec3<T>& a, const Vec3<T>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 template <class T> DL_HD T norm(const Vec3<T>& a) { return std::sqrt(dot(a, a)); }
 template <class T> DL_HD T length(const Vec3<T>& a) { return norm(a); }  // GLSL's name
 // Conversion between precisions (also where a functional cast would be read as aggregate init).

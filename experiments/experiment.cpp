@@ -1,5 +1,6 @@
 #include "experiment.hpp"
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -13,7 +14,7 @@ using nlohmann::json;
 
 namespace {
 
-Experiment from_json(const json& j, const std::string& where) {
+Experiment from_json(const json& j, const std::string& where, const std::string& dir = "") {
   if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
   Experiment x;
   // "base": start from another built-in experiment's scene and settings.
@@ -37,7 +38,7 @@ Experiment from_json(const json& j, const std::string& where) {
     else if (k == "until_converged") {
       if (!v.is_boolean()) throw std::invalid_argument(where + ".until_converged: expected true or false");
       x.until_converged = v.get<bool>();
-    } else if (k == "scene") apply_json(x.scene, v, where + ".scene");
+    } else if (k == "scene") apply_json(x.scene, v, where + ".scene", dir);
     else if (k == "sweep" || k == "base") continue;  // read by parse_sweep / above
     else
       throw std::invalid_argument(where + "." + k +
@@ -54,7 +55,9 @@ Experiment parse_experiment(const std::string& text, const std::string& where) {
   return from_json(parse_json(text, "experiment file '" + where + "'"), where);
 }
 
-Experiment load_experiment(const std::string& path) { return from_json(read_json_file(path, "experiment file"), path); }
+Experiment load_experiment(const std::string& path) {
+  return from_json(read_json_file(path, "experiment file"), path, std::filesystem::path(path).parent_path().string());
+}
 
 Experiment load_experiment_by_name(const std::string& path_or_name) {
   if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos)

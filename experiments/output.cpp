@@ -74,16 +74,22 @@ void OutputDir::commit() {
 void write_ply(const fs::path& file, const Model& m, const State& s) {
   std::ofstream out(file, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + file.string());
-  const bool faces = m.topology == Topology::cloth_grid && m.nx > 1 && m.ny > 1;
-  const std::int64_t nf = faces ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : 0;
+  const bool grid_faces = m.topology == Topology::cloth_grid && m.nx > 1 && m.ny > 1;
+  const std::int64_t nf = grid_faces ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : std::int64_t(m.triangle.size() / 3);
   out << "ply\nformat binary_little_endian 1.0\n"
       << "comment deformlab state at t = " << s.t << " s; positions in m, velocities in m/s\n"
       << "element vertex " << s.x.size() << "\n"
       << "property float x\nproperty float y\nproperty float z\n"
       << "property float vx\nproperty float vy\nproperty float vz\n";
-  if (faces) out << "element face " << nf << "\nproperty list uchar int vertex_indices\n";
+  if (nf) out << "element face " << nf << "\nproperty list uchar int vertex_indices\n";
   out << "end_header\n";
-  // Vertices, then faces made from the grid as they are written: a chunk of records at a time.
+  // Vertices in the mesh file's order (model node at file position f: at[f]), then faces made
+  // as they are written: a chunk of records at a time.
+  std::vector<std::int32_t> at;
+  if (!m.file_node.empty()) {
+    at.resize(m.file_node.size());
+    for (std::size_t v = 0; v < at.size(); ++v) at[m.file_node[v]] = std::int32_t(v);
+  }
   std::vector<char> buf;
   auto flush = [&](bool last) {
     if (buf.size() < (std::size_t(1) << 24) && !last) return;
@@ -93,22 +99,26 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
   auto put = [&](const void* p, std::size_t bytes) {
     buf.insert(buf.end(), static_cast<const char*>(p), static_cast<const char*>(p) + bytes);
   };
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
+  auto face = [&](const std::int32_t (&t)[3]) {
+    const unsigned char three = 3;
+    put(&three, 1);
+    put(t, sizeof t);
+    flush(false);
+  };
+  for (std::size_t f = 0; f < s.x.size(); ++f) {
+    const std::size_t i = at.empty() ? f : std::size_t(at[f]);
     const float v[6] = {s.x[i].x, s.x[i].y, s.x[i].z, s.v[i].x, s.v[i].y, s.v[i].z};
     put(v, sizeof v);
     flush(false);
   }
-  for (int j = 0; faces && j + 1 < m.ny; ++j)
+  for (int j = 0; grid_faces && j + 1 < m.ny; ++j)
     for (int i = 0; i + 1 < m.nx; ++i) {
       const std::int32_t a = j * m.nx + i, b = a + 1, c = a + m.nx, d = c + 1;
-      const std::int32_t tris[2][3] = {{a, c, b}, {b, c, d}};
-      for (const auto& t : tris) {
-        const unsigned char three = 3;
-        put(&three, 1);
-        put(t, sizeof t);
-      }
-      flush(false);
+      face({a, c, b});
+      face({b, c, d});
     }
+  for (std::size_t t = 0; !grid_faces && t + 2 < m.triangle.size(); t += 3)
+    face({m.file_index(m.triangle[t]), m.file_index(m.triangle[t + 1]), m.file_index(m.triangle[t + 2])});
   flush(true);
   if (!out) throw std::runtime_error("failed writing " + file.string());
 }
@@ -166,6 +176,7 @@ nlohmann::json build_info() {
 }
 
 ModelSize model_size(const ModelSpec& ms) {
+  if (ms.topology == Topology::general) throw std::invalid_argument("a mesh's size is known once its file is read");
   const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
                                                   : cloth_spring_counts(ms.nx, ms.ny);
   return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2], true};

@@ -10,6 +10,7 @@
 #include "core/run.hpp"
 #include "core/scene.hpp"
 #include "core/state.hpp"
+#include "mesh/scene_model.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
 #if DEFORMLAB_HAVE_GL

@@ -6,6 +6,7 @@
 
 #include "core/scene.hpp"
 #include "core/state.hpp"
+#include "mesh/scene_model.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
 #include "sweep.hpp"

@@ -26,9 +26,6 @@ Mat4 mul(const Mat4& a, const Mat4& b) {
 }
 
 Vec3f normalized(Vec3f v) { return v * (1.f / norm(v)); }
-Vec3f cross(const Vec3f& a, const Vec3f& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
 
 Mat4 look_at(Vec3f eye, Vec3f at, Vec3f up) {
   const Vec3f f = normalized(at - eye), s = normalized(cross(f, up)), u = cross(s, f);

@@ -9,6 +9,7 @@
 
 #include "core/json_file.hpp"
 #include "core/scene.hpp"
+#include "mesh/scene_model.hpp"
 #include "experiments/output.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

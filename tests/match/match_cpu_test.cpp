@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/cpu_backend.hpp"
+#include "core/node_order.hpp"
 #include "experiments/pipelines.hpp"
 #include "tests/support/test_states.hpp"
 
@@ -35,12 +36,15 @@ struct Shape {
   bool damped;
   bool general = false;  // the same springs without the grid: the adjacency paths
   bool contact = false;  // ground and spheres cutting the cloth, the drag node held on its path
+  enum { grid, surface, volume } mesh = grid;  // meshes: jittered, shuffled node order (the adjacency paths at their worst)
 };
 const Shape kShapes[] = {
     {"cloth32", 32, 32, 0, true},       {"cloth37x53", 37, 53, 0, false},  // not a multiple of any tile
     {"cloth2x3", 2, 3, 0, true},        {"lattice6x5x4", 6, 5, 4, true},
     {"lattice3x4x5", 3, 4, 5, false},  // too narrow for the interior stencil anywhere
     {"general32", 32, 32, 0, true, true},       {"contact37x53", 37, 53, 0, true, false, true},
+    {"surface30x20", 30, 20, 0, true, true, false, Shape::surface},
+    {"volume8x6x5", 8, 6, 5, true, true, false, Shape::volume},
 };
 
 // Option values tried beyond the defaults, by option name (PipelineEntry::options).
@@ -66,6 +70,15 @@ std::string case_name(const testing::TestParamInfo<Case>& p) {
 }
 
 Model make_model(const Shape& s) {
+  if (s.mesh != Shape::grid) {
+    Mesh mesh = s.mesh == Shape::surface ? triangulated_square(s.nx, s.ny, 0.25f) : tetrahedralised_box(s.nx, s.ny, s.nz, 0.25f);
+    repair(mesh);
+    Model m = mesh_model(mesh, Material{}, 0.f);
+    m.damping = {0.02f, 0.02f, 0.01f};
+    pin(m, {0, s.nx - 1});
+    reorder(m, node_order(m, NodeOrder::shuffled, 11));
+    return m;
+  }
   Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny);
   if (s.damped) m.damping = {0.02f, 0.02f, 0.01f};
   return s.general ? explicit_springs(m) : m;

@@ -19,6 +19,46 @@ Model small_lattice(int nx, int ny, int nz, bool pinned) {
   return m;
 }
 
+namespace {
+void jitter_points(Mesh& m, float amount, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (auto& p : m.position) p += Vec3f{u(rng), u(rng), u(rng)} * (amount * 0.05f);
+}
+}  // namespace
+
+Mesh triangulated_square(int nx, int ny, float jitter, std::uint32_t seed) {
+  Mesh m;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) m.position.push_back({0.05f * float(i), 1.f, 0.05f * float(j)});
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+      m.triangle.push_back({a, c, d});
+      m.triangle.push_back({a, d, b});
+    }
+  jitter_points(m, jitter, seed);
+  return m;
+}
+
+Mesh tetrahedralised_box(int nx, int ny, int nz, float jitter, std::uint32_t seed) {
+  Mesh m;
+  auto node = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) m.position.push_back({0.05f * float(i), 1.f + 0.05f * float(j), 0.05f * float(k)});
+  // The six tetrahedra of a cube around its diagonal from corner 0 to corner 7 (corner bits: x, y, z).
+  const int ring[6] = {1, 3, 2, 6, 4, 5};
+  for (int k = 0; k + 1 < nz; ++k)
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        auto corner = [&](int c) { return node(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)); };
+        for (int t = 0; t < 6; ++t) m.tetrahedron.push_back({corner(0), corner(7), corner(ring[t]), corner(ring[(t + 1) % 6])});
+      }
+  jitter_points(m, jitter, seed);
+  return m;
+}
+
 Params small_params() {
   Params p;
   p.dt = 0.001f;

@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "core/integrator.hpp"
+#include "core/mesh_model.hpp"
 #include "core/model.hpp"
 #include "core/params.hpp"
 #include "core/pipeline.hpp"
@@ -14,6 +15,13 @@ namespace deformlab::test {
 // spacing 0.05 m, at height 1 m, top corners pinned unless `pinned` is false.
 Model small_cloth(int nx, int ny, bool pinned = true);
 Model small_lattice(int nx, int ny, int nz, bool pinned = true);
+// Meshes made here: an nx x ny grid of points in the x-z plane at height 1 m split into two
+// triangles per square (diagonal from (i, j) to (i+1, j+1)), and an nx x ny x nz box of
+// points split into six tetrahedra per cube (around the cube's diagonal), spacing 0.05 m,
+// each point moved by up to `jitter` x spacing (seeded) so that rest lengths differ.
+Mesh triangulated_square(int nx, int ny, float jitter = 0.f, std::uint32_t seed = 1);
+Mesh tetrahedralised_box(int nx, int ny, int nz, float jitter = 0.f, std::uint32_t seed = 1);
+
 // Params with dt = 1 ms, gravity, global damping 0.02, spring damping set on the model by
 // the caller if wanted, no colliders, no drag.
 Params small_params();

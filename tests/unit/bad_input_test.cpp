@@ -22,6 +22,14 @@ BadInput scene(const char* name, const std::string& json, const std::string& key
   return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", json}}};
 }
 
+// A scene with a mesh model (`model` holds its other keys) beside a mesh file `name` holding
+// `text` (an open triangle unless given).
+BadInput mesh(const char* name, const std::string& model, const std::string& key,
+              const std::string& text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", const std::string& file = "m.obj") {
+  const std::string scene = "{\"model\": {\"type\": \"mesh\", \"pins\": \"none\", " + model.substr(1) + "}";
+  return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", scene}, {file, text}}};
+}
+
 const std::vector<BadInput>& cases() {
   static const std::vector<BadInput> all = {
       // flags
@@ -90,7 +98,7 @@ const std::vector<BadInput>& cases() {
       scene("spacing_negative", "{\"model\": {\"spacing\": -0.1}}", "s.json.model.spacing: expected a number >= 0"),
       scene("pins_duplicate", "{\"model\": {\"pins\": [0, 0]}}", "s.json.model.pins[1]: node 0 is listed twice"),
       scene("pins_negative", "{\"model\": {\"pins\": [-1]}}", "s.json.model.pins[0]: expected an integer >= 0"),
-      scene("pins_outside", "{\"model\": {\"size\": [8, 8], \"pins\": [99999]}}", "pinned node 99999 is outside the model"),
+      scene("pins_outside", "{\"model\": {\"size\": [8, 8], \"pins\": [99999]}}", "pins[0]: node 99999 is outside the model"),
       scene("pins_name", "{\"model\": {\"pins\": \"bottom\"}}", "s.json.model.pins: expected \"none\""),
       scene("sphere_no_radius", "{\"spheres\": [{\"center\": [0, 0, 0]}]}", "s.json.spheres[0]: needs center and radius"),
       scene("sphere_radius_zero", "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 0}]}",
@@ -106,6 +114,33 @@ const std::vector<BadInput>& cases() {
       scene("drag_keyframe_short", "{\"drag\": {\"path\": [[0, 0, 0]]}}", "s.json.drag.path[0]: expected [t, x, y, z]"),
       scene("drag_keyframes_backwards", "{\"drag\": {\"path\": [[1, 0, 0, 0], [0.5, 0, 0, 0]]}}",
             "s.json.drag.path[1][0]: keyframe times must increase"),
+      // mesh models: the file (named relative to the scene) and the keys
+      mesh("mesh_file_missing", "{\"file\": \"none.obj\"}", "none.obj': no such file"),
+      mesh("mesh_file_empty", "{\"file\": \"m.obj\"}", "m.obj': the file is empty", ""),
+      mesh("mesh_file_truncated", "{\"file\": \"m.stl\"}", "m.stl': Failed to determine STL storage",
+           std::string(80, ' ') + std::string("\x0c\0\0\0", 4) + std::string(50, '\0'), "m.stl"),
+      mesh("mesh_nan", "{\"file\": \"m.obj\"}", "m.obj': vertex 0 has a NaN or infinite coordinate",
+           "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+      mesh("mesh_non_manifold", "{\"file\": \"m.obj\"}", "is shared by 3 triangles (non-manifold)",
+           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n"),
+      mesh("mesh_degenerate", "{\"file\": \"m.obj\"}", "triangle 0 is degenerate: zero area",
+           "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+      mesh("mesh_lines_only", "{\"file\": \"m.obj\"}", "m.obj': no triangles", "v 0 0 0\nv 1 0 0\nl 1 2\n"),
+      mesh("mesh_fill_open", "{\"file\": \"m.obj\", \"fill\": \"tetrahedra\"}", "filling the surface with tetrahedra: "),
+      mesh("mesh_order", "{\"file\": \"m.obj\", \"order\": \"hilbert\"}",
+           "s.json.model.order: expected one of: file, shuffled, rcm, morton"),
+      mesh("mesh_size_key", "{\"size\": [4, 4]}", "s.json.model.size: not a key of a mesh model"),
+      mesh("mesh_scale_zero", "{\"file\": \"m.obj\", \"scale\": 0}", "s.json.model.scale: expected a number > 0"),
+      mesh("mesh_transform_row", "{\"file\": \"m.obj\", \"transform\": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1]]}",
+           "s.json.model.transform[3]: the last row of an affine map is [0, 0, 0, 1]"),
+      mesh("mesh_pins_grid_set", "{\"file\": \"m.obj\", \"pins\": \"top-row\"}", "pin set 'top-row' needs a grid or lattice"),
+      mesh("mesh_pins_box_empty", "{\"file\": \"m.obj\", \"pins\": {\"box\": [[5, 5, 5], [6, 6, 6]]}}",
+           "pins[0]: the box holds no node of the model"),
+      mesh("mesh_pins_box_corners", "{\"file\": \"m.obj\", \"pins\": {\"box\": [[1, 1, 1], [0, 0, 0]]}}",
+           "s.json.model.pins.box: the first corner must be the lowest"),
+      scene("grid_mesh_key", "{\"model\": {\"file\": \"m.obj\"}}", "s.json.model.file: a key of mesh models"),
+      scene("drag_node_box", "{\"drag\": {\"node\": {\"box\": [[0, 0, 0], [1, 1, 1]]}}}",
+            "s.json.drag.node: expected a node index, \"center\" or {\"nearest\": [x, y, z]}"),
       scene("threshold_zero_in_file", "{\"threshold\": 0}", "s.json.threshold: expected a number > 0"),
       scene("min_steps_negative", "{\"min_steps\": -1}", "s.json.min_steps: expected an integer >= 0"),
       scene("max_steps_zero", "{\"max_steps\": 0}", "s.json.max_steps: expected an integer >= 1"),

@@ -116,8 +116,8 @@ TEST(Builders, PinSets) {
   EXPECT_TRUE(pin_nodes(c, PinSet::none, {}).empty());
   EXPECT_EQ(pin_nodes(c, PinSet::top_corners, {}), (std::vector<int>{0, 5}));
   EXPECT_EQ(pin_nodes(c, PinSet::top_row, {}), (std::vector<int>{0, 1, 2, 3, 4, 5}));
-  EXPECT_EQ(pin_nodes(c, PinSet::list, {7, 9}), (std::vector<int>{7, 9}));
-  EXPECT_THROW(pin_nodes(c, PinSet::list, {24}), std::invalid_argument);
+  EXPECT_EQ(pin_nodes(c, PinSet::list, {NodeSelector::node(7), NodeSelector::node(9)}), (std::vector<int>{7, 9}));
+  EXPECT_THROW(pin_nodes(c, PinSet::list, {NodeSelector::node(24)}), std::invalid_argument);
   const Model l = lattice(3, 4, 2, 0.1f, 0.f, Material{});
   // lattice top corners: (0, ny-1, 0) and (nx-1, ny-1, 0), the top layer being y max.
   const auto tc = pin_nodes(l, PinSet::top_corners, {});

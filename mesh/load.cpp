@@ -1,0 +1,177 @@
+#include "load.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/version.h>
+#include <gmsh.h>
+
+#include <filesystem>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace deformlab {
+
+namespace {
+
+[[noreturn]] void bad(const std::string& file, const std::string& what) {
+  throw std::invalid_argument("mesh file '" + file + "': " + what);
+}
+
+Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
+  Assimp::Importer importer;
+  // Positions only, so that joining identical vertices looks at positions alone.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                          aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                                          aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                                          aiComponent_TEXTURES | aiComponent_LIGHTS |
+                                                          aiComponent_CAMERAS | aiComponent_MATERIALS);
+  importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);  // one mesh per object: duplicates across them are welded (and counted) below
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+  if (!scene) bad(path, importer.GetErrorString());
+  Mesh m;
+  std::int64_t points = 0, lines = 0;
+  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+    const aiMesh* a = scene->mMeshes[k];
+    const auto base = std::int64_t(m.position.size());
+    if (base + a->mNumVertices > (std::int64_t(1) << 30)) bad(path, "more than 2^30 vertices");
+    for (unsigned v = 0; v < a->mNumVertices; ++v)
+      m.position.push_back({a->mVertices[v].x, a->mVertices[v].y, a->mVertices[v].z});
+    for (unsigned f = 0; f < a->mNumFaces; ++f) {
+      const aiFace& face = a->mFaces[f];
+      if (face.mNumIndices == 3)
+        m.triangle.push_back({std::int32_t(base + face.mIndices[0]), std::int32_t(base + face.mIndices[1]),
+                              std::int32_t(base + face.mIndices[2])});
+      else if (face.mNumIndices == 2) ++lines;
+      else ++points;
+    }
+  }
+  if (points || lines)
+    notes.push_back("left out " + std::to_string(points) + " points and " + std::to_string(lines) + " lines");
+  if (m.triangle.empty()) bad(path, "no triangles");
+  return m;
+}
+
+// Gmsh for the length of one task; its errors become exceptions with Gmsh's message.
+class GmshSession {
+ public:
+  GmshSession() {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.AbortOnError", 2);
+  }
+  ~GmshSession() { gmsh::finalize(); }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+  template <class F>
+  static void run(const std::string& what, F&& f) {
+    try {
+      f();
+    } catch (const std::invalid_argument&) {
+      throw;
+    } catch (...) {
+      std::string error;
+      gmsh::logger::getLastError(error);
+      throw std::invalid_argument(what + ": " + (error.empty() ? "Gmsh failed" : error));
+    }
+  }
+};
+
+// The current Gmsh model's linear tetrahedra or, if it has none, its triangles.
+Mesh read_gmsh_model(const std::string& what) {
+  std::vector<std::size_t> tags;
+  std::vector<double> coord, param;
+  gmsh::model::mesh::getNodes(tags, coord, param, -1, -1, false, false);
+  Mesh m;
+  if (tags.size() > (std::size_t(1) << 30)) throw std::invalid_argument(what + ": more than 2^30 nodes");
+  std::unordered_map<std::size_t, std::int32_t> index;
+  index.reserve(tags.size());
+  m.position.resize(tags.size());
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    index[tags[k]] = std::int32_t(k);
+    m.position[k] = {float(coord[3 * k]), float(coord[3 * k + 1]), float(coord[3 * k + 2])};
+  }
+  std::vector<int> types;
+  gmsh::model::mesh::getElementTypes(types);
+  const bool volume = std::find(types.begin(), types.end(), 4) != types.end();
+  for (int t : types) {
+    std::string name;
+    int dim = 0, order = 0, nodes = 0, primary = 0;
+    std::vector<double> local;
+    gmsh::model::mesh::getElementProperties(t, name, dim, order, nodes, local, primary);
+    if (dim == 3 && t != 4) throw std::invalid_argument(what + ": holds " + name + " elements (only 4-node tetrahedra are read)");
+    if (dim == 2 && !volume && t != 2)
+      throw std::invalid_argument(what + ": holds " + name + " elements (only 3-node triangles are read)");
+  }
+  std::vector<std::size_t> elements, nodes;
+  gmsh::model::mesh::getElementsByType(volume ? 4 : 2, elements, nodes);
+  auto at = [&](std::size_t tag) {
+    const auto it = index.find(tag);
+    if (it == index.end()) throw std::invalid_argument(what + ": an element refers to node " + std::to_string(tag) + ", which is not in the file");
+    return it->second;
+  };
+  if (volume) {
+    m.tetrahedron.resize(elements.size());
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      for (int c = 0; c < 4; ++c) m.tetrahedron[e][c] = at(nodes[4 * e + c]);
+  } else {
+    m.triangle.resize(elements.size());
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      for (int c = 0; c < 3; ++c) m.triangle[e][c] = at(nodes[3 * e + c]);
+  }
+  if (elements.empty()) throw std::invalid_argument(what + ": no tetrahedra or triangles");
+  return m;
+}
+
+}  // namespace
+
+Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) bad(path, "no such file");
+  if (std::filesystem::file_size(path, ec) == 0) bad(path, "the file is empty");
+  if (std::filesystem::path(path).extension() != ".msh") return load_with_assimp(path, notes);
+  GmshSession gmsh;
+  Mesh m;
+  GmshSession::run("mesh file '" + path + "'", [&] {
+    gmsh::open(path);
+    m = read_gmsh_model("mesh file '" + path + "'");
+  });
+  return m;
+}
+
+Mesh fill_tetrahedra(const Mesh& surface, float cell_size) {
+  GmshSession gmsh;
+  Mesh m;
+  GmshSession::run("filling the surface with tetrahedra", [&] {
+    gmsh::model::add("fill");
+    const int s = gmsh::model::addDiscreteEntity(2);
+    std::vector<std::size_t> tags(surface.position.size()), nodes;
+    std::vector<double> coord;
+    for (std::size_t v = 0; v < tags.size(); ++v) {
+      tags[v] = v + 1;
+      for (int c = 0; c < 3; ++c) coord.push_back(surface.position[v][c]);
+    }
+    for (const auto& t : surface.triangle)
+      for (auto v : t) nodes.push_back(std::size_t(v) + 1);
+    gmsh::model::mesh::addNodes(2, s, tags, coord);
+    gmsh::model::mesh::addElementsByType(s, 2, {}, nodes);
+    gmsh::model::geo::addVolume({gmsh::model::geo::addSurfaceLoop({s})});
+    gmsh::model::geo::synchronize();
+    if (cell_size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", cell_size);
+    gmsh::option::setNumber("General.NumThreads", 0);  // all cores
+    gmsh::model::mesh::generate(3);
+    m = read_gmsh_model("filling the surface with tetrahedra");
+    if (!m.volume()) throw std::invalid_argument("Gmsh made no tetrahedra (is the surface closed?)");
+  });
+  return m;
+}
+
+std::string mesh_library_versions() {
+  return "assimp " + std::to_string(aiGetVersionMajor()) + "." + std::to_string(aiGetVersionMinor()) + "." +
+         std::to_string(aiGetVersionPatch()) + ", Gmsh " + GMSH_API_VERSION;
+}
+
+}  // namespace deformlab

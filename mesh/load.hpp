@@ -1,0 +1,26 @@
+// Mesh files: triangle surfaces through assimp (OBJ, PLY, STL, glTF and the other formats it
+// reads), tetrahedral volumes from Gmsh's .msh through the Gmsh API, and a closed surface
+// filled with tetrahedra by Gmsh's 3D mesher.
+#pragma once
+#include <string>
+
+#include "core/mesh_model.hpp"
+
+namespace deformlab {
+
+// Reads a mesh as its library gives it (Gmsh: .msh, nodes in Gmsh's order; assimp: everything
+// else, vertices in the order assimp delivers them: for OBJ, the order in which faces first use
+// them). Polygons are split into triangles; assimp joins identical vertices within each object
+// of the file (OBJ and STL repeat a vertex per face), and vertices shared between objects are
+// left for repair() to weld and count. Points and lines are left out and counted in `notes`.
+// Throws std::invalid_argument naming the file and the problem.
+Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
+
+// The closed surface filled with tetrahedra (Gmsh, its nodes kept); cell_size > 0 caps the
+// tetrahedra's edges. Throws std::invalid_argument when Gmsh cannot fill it.
+Mesh fill_tetrahedra(const Mesh& surface, float cell_size);
+
+// The library versions, for manifests.
+std::string mesh_library_versions();
+
+}  // namespace deformlab

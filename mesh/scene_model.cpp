@@ -1,0 +1,75 @@
+#include "scene_model.hpp"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "core/memory.hpp"
+#include "load.hpp"
+
+namespace deformlab {
+
+namespace {
+
+void place(Mesh& m, const MeshSpec& s) {
+  const auto& t = s.transform;
+  for (auto& p : m.position) {
+    const Vec3f q{p.x * s.scale.x, p.y * s.scale.y, p.z * s.scale.z};
+    for (int r = 0; r < 3; ++r) p[r] = t[r * 4] * q.x + t[r * 4 + 1] * q.y + t[r * 4 + 2] * q.z + t[r * 4 + 3];
+  }
+}
+
+// Refuses a mesh whose model would not fit beside what the host has left.
+void check_memory(const Mesh& mesh) {
+  const auto limit = host_memory_limit();
+  if (!limit) return;
+  const std::int64_t need =
+      model_host_bytes({std::int64_t(mesh.position.size()), mesh_spring_bound(mesh), false}) +
+      std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()) * 64;  // sorting the elements' sides
+  if (need > limit->bytes)
+    throw std::invalid_argument("its model needs up to " + gib(need) + " of host memory; " +
+                                limit->name + " leaves " + gib(limit->bytes));
+}
+
+Model mesh_from_file(const ModelSpec& spec) {
+  const MeshSpec& ms = spec.mesh;
+  if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file)");
+  std::vector<std::string> notes;
+  Mesh mesh = load_mesh(ms.file, notes);
+  place(mesh, ms);
+  try {
+    for (auto& line : repair(mesh)) notes.push_back(std::move(line));
+    if (ms.fill) {
+      if (mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
+      mesh = fill_tetrahedra(mesh, ms.cell_size);
+      for (auto& line : repair(mesh)) notes.push_back("after filling: " + line);
+    }
+    check_memory(mesh);
+    Model m = mesh_model(mesh, spec.material, ms.density);
+    m.repairs = std::move(notes);
+    return m;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("mesh file '" + ms.file + "': " + e.what());
+  }
+}
+
+}  // namespace
+
+Model build_model(const Scene& s) {
+  const ModelSpec& m = s.model;
+  Model model;
+  if (m.topology == Topology::general) {
+    model = mesh_from_file(m);
+  } else {
+    if (m.nx < 1 || m.ny < 1 || m.nz < 1) throw std::invalid_argument("model size must be positive in every dimension");
+    float h = m.spacing;
+    if (h == 0.f) h = m.nx > 1 ? m.width / float(m.nx - 1) : m.width;
+    model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
+                                            : cloth_grid(m.nx, m.ny, h, m.height, m.material);
+  }
+  pin(model, pin_nodes(model, m.pins, m.pin_list));  // before reordering: indices are the file's
+  if (m.topology == Topology::general && m.mesh.order != NodeOrder::file)
+    reorder(model, node_order(model, m.mesh.order, m.mesh.seed));
+  return model;
+}
+
+}  // namespace deformlab

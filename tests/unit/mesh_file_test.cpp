@@ -1,0 +1,193 @@
+// Mesh files (mesh/load.hpp, mesh/scene_model.hpp): each format read through its library,
+// counts against the mesh written, Gmsh volumes and filling, the committed bunny, scenes
+// that pick nodes by position, and runs reported in the file's order whatever the internal one.
+#include <gtest/gtest.h>
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#include <gmsh.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/cpu_backend.hpp"
+#include "core/scene.hpp"
+#include "mesh/load.hpp"
+#include "mesh/scene_model.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+class MeshFile : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("deformlab-mesh-" + std::to_string(::getpid()) + "-" +
+                                        testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return (dir_ / name).string();
+  }
+  Mesh load(const std::string& path) {
+    std::vector<std::string> notes;
+    Mesh m = load_mesh(path, notes);
+    notes_ = notes;
+    return m;
+  }
+  fs::path dir_;
+  std::vector<std::string> notes_;
+};
+
+// A 3 x 2 grid of squares as OBJ quads: assimp splits them into triangles.
+const char* kQuads = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 0 0 1\nv 1 0 1\nv 2 0 1\nv 3 0 1\n"
+                     "v 0 0 2\nv 1 0 2\nv 2 0 2\nv 3 0 2\n"
+                     "f 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 5 9 10 6\nf 6 10 11 7\nf 7 11 12 8\n";
+
+TEST_F(MeshFile, ObjPolygonsBecomeTriangles) {
+  Mesh m = load(write("q.obj", kQuads));
+  EXPECT_EQ(m.position.size(), 12u);
+  EXPECT_EQ(m.triangle.size(), 12u);
+  EXPECT_TRUE(repair(m).empty());
+  const Model model = mesh_model(m, Material{}, 0.f);
+  EXPECT_EQ(model.spring_count(), 17 + 6 + (17 + 6 - 10));  // 17 grid edges + 6 diagonals, bending on interior edges
+}
+
+TEST_F(MeshFile, ObjectsSharingPositionsAreWeldedAndCounted) {
+  Mesh m = load(write("two.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n"
+                                 "o b\nv 1 0 0\nv 0 0 1\nv 1 0 1\nf 4 6 5\n"));
+  EXPECT_EQ(m.position.size(), 6u);
+  EXPECT_EQ(repair(m), std::vector<std::string>{"welded 2 duplicate vertices"});
+  EXPECT_EQ(m.position.size(), 4u);
+  EXPECT_EQ(mesh_model(m, Material{}, 0.f).spring_count(), 5 + 1);  // 5 edges, one bending pair
+}
+
+TEST_F(MeshFile, PlyStlAndGltfGiveTheObjsMesh) {
+  // The same closed surface (a tetrahedron) exported by assimp in each format, read back.
+  const std::string obj = write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(obj, 0);
+  ASSERT_NE(scene, nullptr);
+  Assimp::Exporter exporter;
+  for (const auto& [id, ext] : {std::pair{"plyb", "ply"}, {"stl", "stl"}, {"stlb", "stl"}, {"gltf2", "gltf"}, {"glb2", "glb"}}) {
+    const std::string file = (dir_ / (std::string("t_") + id + "." + ext)).string();
+    ASSERT_EQ(exporter.Export(scene, id, file), aiReturn_SUCCESS) << exporter.GetErrorString();
+    Mesh m = load(file);
+    repair(m);
+    EXPECT_EQ(m.position.size(), 4u) << id;
+    EXPECT_EQ(m.triangle.size(), 4u) << id;
+    EXPECT_EQ(mesh_model(m, Material{}, 0.f).spring_count(), 6) << id << ": 6 edges; bending pairs are edges";
+  }
+}
+
+TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
+  auto error = [&](const std::string& name, const std::string& text) {
+    try {
+      Scene s;
+      apply_json(s, nlohmann::json{{"model", {{"type", "mesh"}, {"file", name}, {"pins", "none"}}}}, "s", dir_.string());
+      if (!text.empty() || name != "none.obj") write(name, text);
+      build_model(s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string at = "mesh file '" + (dir_ / "").string();
+  EXPECT_EQ(error("none.obj", ""), at + "none.obj': no such file");
+  EXPECT_EQ(error("e.obj", ""), at + "e.obj': the file is empty");
+  EXPECT_EQ(error("n.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), at + "n.obj': vertex 0 has a NaN or infinite coordinate");
+  EXPECT_EQ(error("l.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"), at + "l.obj': no triangles");
+  std::string stl(80, ' ');
+  stl += std::string("\x0c\0\0\0", 4) + std::string(50, '\0');  // 12 triangles announced, one there
+  EXPECT_EQ(error("cut.stl", stl).rfind(at + "cut.stl': ", 0), 0u);
+  EXPECT_EQ(error("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "accepted");
+}
+
+// A Gmsh box meshed and written as .msh, read back: linear tetrahedra, the box's volume.
+TEST_F(MeshFile, GmshVolumesAreRead) {
+  const std::string msh = (dir_ / "box.msh").string();
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("box");
+  gmsh::model::occ::addBox(0, 0, 0, 0.3, 0.2, 0.1);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.05);
+  gmsh::model::mesh::generate(3);
+  gmsh::write(msh);
+  gmsh::finalize();
+  Mesh m = load(msh);
+  ASSERT_TRUE(m.volume());
+  EXPECT_TRUE(repair(m).empty());
+  const Model model = mesh_model(m, Material{}, 1000.f);
+  double mass = 0;
+  for (float w : model.inv_mass) mass += 1.0 / w;
+  EXPECT_NEAR(mass, 1000.0 * 0.3 * 0.2 * 0.1, 1e-3);
+  EXPECT_GT(std::count(model.kind.begin(), model.kind.end(), SpringKind::flexion), 0);
+}
+
+TEST_F(MeshFile, TheBunnyIsClosedAndFillsWithTetrahedra) {
+  Mesh surface = load(DEFORMLAB_SOURCE_DIR "/data/bunny/bunny.obj");
+  EXPECT_TRUE(repair(surface).empty());
+  EXPECT_EQ(surface.position.size(), 1839u);
+  EXPECT_EQ(surface.triangle.size(), 3674u);
+  const Model s = mesh_model(surface, Material{}, 0.f);
+  // Closed and of genus 0: V - E + F = 2, and every edge is interior.
+  const auto edges = std::count(s.kind.begin(), s.kind.end(), SpringKind::structural);
+  EXPECT_EQ(1839 - edges + 3674, 2);
+  Mesh volume = fill_tetrahedra(surface, 0.f);
+  EXPECT_TRUE(repair(volume).empty());
+  const Model v = mesh_model(volume, Material{}, 1.f);
+  EXPECT_GE(v.node_count(), 1839);
+  EXPECT_EQ(v.triangle.size(), 3u * 3674) << "the boundary is the bunny's surface";
+  double filled = 0;
+  for (float w : v.inv_mass) filled += 1.0 / w;  // density 1: the volume
+  // The divergence theorem on the surface gives its enclosed volume.
+  double enclosed = 0;
+  for (const auto& t : surface.triangle)
+    enclosed += dot(Vec3d(surface.position[t[0]]), cross(Vec3d(surface.position[t[1]]), Vec3d(surface.position[t[2]]))) / 6.0;
+  EXPECT_NEAR(filled, std::abs(enclosed), 1e-4 * std::abs(enclosed));
+}
+
+// One scene in two node orders: the pins and the drag node are the same nodes, and the
+// trajectories agree node by node in the file's order.
+TEST_F(MeshFile, NodeOrderChangesNothingButSpeed) {
+  write("sheet.obj", kQuads);
+  auto scene = [&](const char* order) {
+    Scene s;
+    apply_json(s, nlohmann::json::parse(std::string(R"({"model": {"type": "mesh", "file": "sheet.obj", "scale": 0.1,
+        "order": ")") + order + R"(", "pins": [{"box": [[-1, -1, -1], [0.01, 1, 1]]}]},
+        "dt": 0.001, "ground": null, "spheres": [], "drag": {"node": {"nearest": [0.3, 0, 0.2]}, "path": [[0, 0, 0, 0], [1, 0, 0.1, 0]]}})"),
+               "s", dir_.string());
+    return s;
+  };
+  const Scene a = scene("file"), b = scene("shuffled");
+  const Model ma = build_model(a), mb = build_model(b);
+  const Params pa = resolve_params(a, ma), pb = resolve_params(b, mb);
+  EXPECT_EQ(mb.file_index(pb.drag.node), pa.drag.node);
+  EXPECT_EQ(ma.rest_position[pa.drag.node], (Vec3f{0.3f, 0.f, 0.2f}));
+  int pins = 0;
+  for (int v = 0; v < mb.node_count(); ++v) {
+    EXPECT_EQ(mb.pinned(v), ma.pinned(mb.file_index(v)));
+    EXPECT_EQ(ma.pinned(v), ma.rest_position[v].x == 0.f);
+    pins += ma.pinned(v);
+  }
+  EXPECT_EQ(pins, 3);
+  auto run = [](const Model& m, const Params& p) {
+    auto cpu = make_cpu_pipeline({m, p, Integrator::semi_implicit_euler, {}}, Precision::f64, false);
+    return advance(*cpu, rest_state(m), 100);
+  };
+  const State sa = run(ma, pa), sb = run(mb, pb);
+  double d = 0;
+  for (int v = 0; v < mb.node_count(); ++v) d = std::max(d, double(norm(sb.x[v] - sa.x[mb.file_index(v)])));
+  EXPECT_LT(d, 1e-6);
+  EXPECT_GT(max_position_diff(sa, rest_state(ma)), 1e-3) << "the sheet must move";
+}
+
+}  // namespace
+}  // namespace deformlab::test
