@@ -50,7 +50,9 @@ GLint bound_framebuffer(GLenum which = GL_DRAW_FRAMEBUFFER_BINDING) {
 struct Renderer::Impl {
   const Model& m;
   RenderOptions o;
-  bool surface;
+  bool surface;  // a cloth grid's surface, made from the grid
+  bool mesh;     // a mesh's triangles (Model::triangle), drawn by index
+  Buffer elements;
   Framebuffer fbo;
   Renderbuffer color, depth;
   Program prog;
@@ -72,10 +74,13 @@ struct Renderer::Impl {
   Impl(const Model& model, RenderOptions opt) : m(model), o(opt) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
       throw std::invalid_argument("frame size must be between 1 and 16384 pixels");
-    surface = o.mode == RenderOptions::Mode::surface ||
-              (o.mode == RenderOptions::Mode::automatic && m.topology == Topology::cloth_grid);
+    const bool surface_wanted = o.mode == RenderOptions::Mode::surface ||
+                                (o.mode == RenderOptions::Mode::automatic &&
+                                 (m.topology == Topology::cloth_grid || !m.triangle.empty()));
+    mesh = surface_wanted && !m.triangle.empty();
+    surface = surface_wanted && !mesh;
     if (surface && (m.topology != Topology::cloth_grid || m.nx < 2 || m.ny < 2))
-      throw std::invalid_argument("surface rendering needs a cloth grid of at least 2x2 nodes");
+      throw std::invalid_argument("surface rendering needs a cloth grid of at least 2x2 nodes or a mesh's triangles");
     GLuint id = 0;
     glGenRenderbuffers(1, &id);
     color = Renderbuffer(id);
@@ -102,6 +107,13 @@ struct Renderer::Impl {
     glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &align);
     plan_bands(o.band_texels > 0 ? std::min<std::int64_t>(o.band_texels, texels) : texels,
                std::lcm(std::max(align, 1), 16) / 16);
+    if (mesh) {
+      if (bands.size() > 1)
+        throw std::invalid_argument("a mesh of " + std::to_string(m.node_count()) +
+                                    " nodes is more than one texture buffer holds (" + std::to_string(texels) +
+                                    " texels): draw it as points");
+      elements = make_buffer(m.triangle.size() * sizeof(std::int32_t), m.triangle.data());
+    }
     // Camera: in front of and above the rest shape and the space below it where a pinned
     // model hangs, looking at the centre of both.
     Vec3f lo = m.rest_position[0], hi = lo;
@@ -154,6 +166,7 @@ struct Renderer::Impl {
     glUniformMatrix4fv(uniform(prog.id(), "u_view_proj"), 1, GL_FALSE, view_proj.data());
     glUniform2i(uniform(prog.id(), "u_grid"), m.nx, m.ny);
     glUniform1i(uniform(prog.id(), "u_surface"), surface ? 1 : 0);
+    glUniform1i(uniform(prog.id(), "u_mesh"), mesh ? 1 : 0);
     glUniform1f(uniform(prog.id(), "u_point_size"),
                 std::clamp(float(o.width) / std::sqrt(float(m.node_count())) * 0.4f, 1.f, 8.f));
     glUniform3f(uniform(prog.id(), "u_eye"), eye.x, eye.y, eye.z);
@@ -167,8 +180,14 @@ struct Renderer::Impl {
       glTexBufferRange(GL_TEXTURE_BUFFER, GL_RGBA32F, positions, GLintptr(b.tex_first * 16), GLsizeiptr(b.tex_count * 16));
       glUniform1i(uniform(prog.id(), "u_first"), b.first);
       glUniform1i(uniform(prog.id(), "u_tex_first"), int(b.tex_first));
-      if (surface) glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * std::int64_t(quads_per_row) * b.count));
-      else glDrawArrays(GL_POINTS, 0, b.count);
+      if (mesh) {
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, elements.id());
+        glDrawElements(GL_TRIANGLES, GLsizei(m.triangle.size()), GL_UNSIGNED_INT, nullptr);
+      } else if (surface) {
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * std::int64_t(quads_per_row) * b.count));
+      } else {
+        glDrawArrays(GL_POINTS, 0, b.count);
+      }
     }
     glBindVertexArray(0);
     glUseProgram(0);

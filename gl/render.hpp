@@ -1,5 +1,5 @@
-// Drawing a state into an offscreen framebuffer (points, or a lit cloth surface with its
-// normals computed on the GPU), PNG frames and an MP4 through ffmpeg when it is installed.
+// Drawing a state into an offscreen framebuffer (points, or a lit surface: a cloth grid's with
+// normals from its neighbours, a mesh's triangles with flat normals, all computed on the GPU), PNG frames and an MP4 through ffmpeg when it is installed.
 // Works for every pipeline: GL pipelines are drawn from their own buffers, others uploaded.
 #pragma once
 #include <cstdint>
@@ -17,7 +17,8 @@ namespace deformlab::gl {
 
 struct RenderOptions {
   int width = 1024, height = 1024;  // the paper's output size
-  enum class Mode { automatic, points, surface } mode = Mode::automatic;  // automatic: surface for cloth grids
+  // automatic: a surface for cloth grids and for meshes (their triangles, a volume's boundary)
+  enum class Mode { automatic, points, surface } mode = Mode::automatic;
   // Texels of position data one draw call reads (0: the driver's texture buffer limit); a
   // larger model is drawn in bands. A cloth wider than twice the frame is drawn every
   // stride-th row and column.

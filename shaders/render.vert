@@ -1,7 +1,8 @@
 #version 430 core
 // Draws the state straight from the position buffer (a texture buffer over one band of the
-// nodes, by gl_VertexID): points, or a cloth surface made here with no index buffer: 6
-// vertices per quad of the grid sampled every u_stride nodes, normals from the neighbours.
+// nodes, by gl_VertexID): points, a mesh's triangles (gl_VertexID is then the index from
+// the element buffer), or a cloth surface made here with no index buffer: 6 vertices per
+// quad of the grid sampled every u_stride nodes, normals from the neighbours.
 layout(binding = 0) uniform samplerBuffer u_pos;
 uniform mat4 u_view_proj;
 uniform ivec2 u_grid;     // cloth nx, ny (surface mode)

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/cpu_backend.hpp"
+#include "core/node_order.hpp"
 #include "gl_test_support.hpp"
 #include "gl/render.hpp"
 #include "tests/support/test_states.hpp"
@@ -87,6 +88,29 @@ TEST(GlRender, BandsAndStridesDrawTheSameModel) {
   gl::Renderer r(wide, {128, 128, gl::RenderOptions::Mode::automatic, 20 * 700});
   r.draw(rest_state(wide));
   expect_centred(coverage(r.pixels(), 128, 128), 128, 128, 0.015, "a 700x90 cloth drawn every 2nd node");
+}
+
+// A mesh is drawn as its triangles (a volume as its boundary): a closed surface where its
+// points alone leave gaps, the same from a shuffled node order and from a GL pipeline's buffers.
+TEST(GlRender, MeshTrianglesInAnyNodeOrder) {
+  DEFORMLAB_REQUIRE_GL();
+  Mesh box = tetrahedralised_box(6, 5, 4);
+  repair(box);
+  const Model m = mesh_model(box, Material{}, 0.f);
+  Model shuffled = m;
+  reorder(shuffled, node_order(shuffled, NodeOrder::shuffled, 4));
+  gl::Renderer faces(m, {200, 200}), again(shuffled, {200, 200}), points(m, {200, 200, gl::RenderOptions::Mode::points});
+  faces.draw(rest_state(m));
+  again.draw(rest_state(shuffled));
+  points.draw(rest_state(m));
+  const Coverage f = coverage(faces.pixels(), 200, 200), p = coverage(points.pixels(), 200, 200);
+  expect_centred(f, 200, 200, 0.05, "a tetrahedral box's boundary");
+  EXPECT_GT(f.pixels, 2 * p.pixels) << "the faces fill what the points leave open";
+  EXPECT_EQ(coverage(again.pixels(), 200, 200).pixels, f.pixels);
+  auto pipe = make_gl("glsl-compute", {shuffled, small_params(), Integrator::semi_implicit_euler});
+  pipe->set_state(rest_state(shuffled));
+  again.draw(*pipe);
+  EXPECT_EQ(coverage(again.pixels(), 200, 200).pixels, f.pixels) << "drawn from the pipeline's own buffer";
 }
 
 TEST(GlRender, LatticeAsPointsAndPngFile) {
