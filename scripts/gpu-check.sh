@@ -34,7 +34,7 @@ match_tests="$build/tests/match/deformlab_match_tests"
 if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
     {
-      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*'
+      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*volume8x6x5*'
       compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
@@ -84,11 +84,39 @@ JSON
     cell=$(ls "$out"/results/clock-check/cells/*"$p"* 2>/dev/null | head -1)
     summary+=("timing $p 2048^2 paper scene, ms/step: run $(median_of median_step_ms "$out/timing-run-$p.json"), cell $(median_of median_ms "$cell")")
   done
-  for every in 1 400; do
-    "$app" run --experiment table2 --pipeline cuda-fused --grid 2048x2048 --steps 400 --check-every "$every" --no-state \
-      --out "/tmp/check-$every" >"$out/timing-check-$every.log" 2>&1
-    summary+=("cuda-fused 2048^2, stop rule every $every steps: wall $(median_of wall_ms /tmp/check-$every/manifest.json) ms for 400 steps, median step $(median_of median_step_ms /tmp/check-$every/manifest.json) ms")
+  for p in cuda-fused glsl-compute; do
+    for every in 1 400; do
+      "$app" run --experiment table2 --pipeline "$p" --grid 2048x2048 --steps 400 --check-every "$every" --no-state \
+        --out "/tmp/check-$p-$every" >"$out/timing-check-$p-$every.log" 2>&1
+      summary+=("$p 2048^2, stop rule every $every steps: wall $(median_of wall_ms /tmp/check-$p-$every/manifest.json) ms for 400 steps, median step $(median_of median_step_ms /tmp/check-$p-$every/manifest.json) ms")
+    done
   done
+fi
+
+# Node order on a mesh: a 1024 x 1024 triangulated sheet (1 M nodes, written as OBJ here)
+# in each order, 200 steps of the paper's drag scene on each GPU pipeline, the stop rule once.
+if part mesh; then
+  python3 - "$out/sheet.obj" <<'PY'
+import sys
+n = 1024
+with open(sys.argv[1], "w") as f:
+    f.write("".join(f"v {i / (n - 1) - 0.5:.7f} 1 {j / (n - 1) - 0.5:.7f}\n" for j in range(n) for i in range(n)))
+    f.write("".join(f"f {j*n+i+1} {(j+1)*n+i+1} {(j+1)*n+i+2}\nf {j*n+i+1} {(j+1)*n+i+2} {j*n+i+2}\n"
+                    for j in range(n - 1) for i in range(n - 1)))
+PY
+  for order in file shuffled rcm morton; do
+    cat >"$out/sheet-$order.json" <<JSON
+{"model": {"type": "mesh", "file": "sheet.obj", "order": "$order", "pins": [{"nearest": [-0.5, 1, -0.5]}, {"nearest": [0.5, 1, -0.5]}]},
+ "drag": {"node": {"nearest": [0, 1, 0]}, "path": [[0, 0, 0, 0], [1, 0, 0.3, 0]]}}
+JSON
+    for p in cuda-fused cuda-naive cuda-tiled cuda-scatter glsl-compute; do
+      "$app" run --scene "$out/sheet-$order.json" --pipeline "$p" --steps 200 --check-every 100000 --no-state \
+        --out "/tmp/mesh-$order-$p" >"$out/mesh-$order-$p.log" 2>&1
+      cp "/tmp/mesh-$order-$p/manifest.json" "$out/mesh-$order-$p.json" 2>/dev/null
+      summary+=("mesh sheet 1M order $order $p: median $(median_of median_step_ms "$out/mesh-$order-$p.json") ms/step, bandwidth $(median_of bandwidth "$out/mesh-$order-$p.json")")
+    done
+  done
+  rm -f "$out/sheet.obj"
 fi
 
 # The largest grids: 20 steps with the stop rule checked every step (state.ply left out: 13 GB
