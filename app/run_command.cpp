@@ -48,7 +48,9 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
 #if DEFORMLAB_GL_RENDER
   std::optional<gl::FrameWriter> frames;
   if (a.frames) {
-    frames.emplace(in.model, dir.staged("frames"), *a.frames);
+    gl::RenderOptions look;
+    look.ground = in.params.ground;
+    frames.emplace(in.model, dir.staged("frames"), *a.frames, look);
     opt.after_step = [&](int step) {
       HostSpan span(&profiler, span::render);
       frames->after_step(pipe, step);

@@ -120,6 +120,12 @@ struct Renderer::Impl {
     for (const auto& p : m.rest_position)
       for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
     lo.y -= 0.6f * std::max({hi.x - lo.x, hi.z - lo.z});
+    if (o.ground) {  // dropped onto the ground: down to it, and half the model's size to each side
+      const Vec3f half = (hi - lo) * 0.5f;
+      lo = lo - Vec3f{half.x, 0.f, half.z};
+      hi = hi + Vec3f{half.x, 0.f, half.z};
+      lo.y = std::min(lo.y, *o.ground - 0.05f * (hi.y - lo.y));
+    }
     const Vec3f centre = (lo + hi) * 0.5f;
     const float radius = std::max(0.5f * norm(hi - lo), 1e-3f);
     eye = centre + Vec3f{0.f, 0.9f, 2.2f} * radius;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct RenderOptions {
   // larger model is drawn in bands. A cloth wider than twice the frame is drawn every
   // stride-th row and column.
   std::int64_t band_texels = 0;
+  // The scene's ground height: the camera frames down to it and half the model's width to each
+  // side (a model dropped onto it stays in view).
+  std::optional<float> ground;
 };
 
 class Renderer {
