@@ -74,6 +74,12 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     return s;
   }
 
+  void set_drag(const DragHandle& d) override {
+    validate(d, m_.node_count());
+    p_.drag = d;
+    set_drag_params<Real>(sp_, d);
+  }
+
   void step() override {
     run_passes(sched_, t_, p_.dt, *this, *this);
     constrain_and_commit();

@@ -34,22 +34,25 @@ void validate(const Params& p, int node_count) {
   for (const auto& s : p.spheres)
     if (!finite(s.center) || !(s.radius > 0.f) || !std::isfinite(s.radius))
       bad("a sphere needs a finite centre and a positive radius");
-  if (p.drag.node >= node_count)
-    bad("drag node " + std::to_string(p.drag.node) + " is outside the model (0.." +
-        std::to_string(node_count - 1) + ")");
-  if (p.drag.node >= 0 && p.drag.path.empty()) bad("the drag handle needs at least one keyframe");
-  for (std::size_t k = 0; k < p.drag.path.size(); ++k) {
-    if (!finite(p.drag.path[k].position) || !std::isfinite(p.drag.path[k].t))
-      bad("drag keyframe " + std::to_string(k) + " is not finite");
-    if (k > 0 && !(p.drag.path[k].t > p.drag.path[k - 1].t))
-      bad("drag keyframe times must increase (keyframe " + std::to_string(k) + ")");
-  }
-  if (p.drag.as_spring && !(p.drag.stiffness > 0.f)) bad("drag spring stiffness must be positive");
+  validate(p.drag, node_count);
   if (!(p.threshold > 0.f) || !std::isfinite(p.threshold)) bad("threshold must be positive");
   if (p.min_steps < 0) bad("min_steps must be >= 0");
   if (p.max_steps < 1) bad("max_steps (--steps) must be at least 1");
   if (p.check_every < 1) bad("check_every must be at least 1");
   if (!(p.runaway_factor > 0.f)) bad("runaway_factor must be positive");
+}
+
+void validate(const DragHandle& d, int node_count) {
+  if (d.node >= node_count)
+    bad("drag node " + std::to_string(d.node) + " is outside the model (0.." + std::to_string(node_count - 1) + ")");
+  if (d.node >= 0 && d.path.empty()) bad("the drag handle needs at least one keyframe");
+  for (std::size_t k = 0; k < d.path.size(); ++k) {
+    if (!finite(d.path[k].position) || !std::isfinite(d.path[k].t))
+      bad("drag keyframe " + std::to_string(k) + " is not finite");
+    if (k > 0 && !(d.path[k].t > d.path[k - 1].t))
+      bad("drag keyframe times must increase (keyframe " + std::to_string(k) + ")");
+  }
+  if (d.as_spring && !(d.stiffness > 0.f)) bad("drag spring stiffness must be positive");
 }
 
 }  // namespace deformlab

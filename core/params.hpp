@@ -46,7 +46,8 @@ struct Params {
   float runaway_factor = 1.f;           // diverged if a node moves > factor * model extent in one step
 };
 
-// Throws std::invalid_argument naming the first bad field.
+// Throw std::invalid_argument naming the first bad field.
 void validate(const Params& p, int node_count);
+void validate(const DragHandle& d, int node_count);
 
 }  // namespace deformlab

@@ -23,12 +23,19 @@ class Pipeline {
   virtual void set_state(const State& s) = 0;
   virtual State state() = 0;  // a read-back on GPU pipelines: not for every step
   virtual void step() = 0;    // advance by params.dt with the integrator's schedule
+  // Replaces the drag handle (its node, path and mode) from the next step on, as the viewer's
+  // picking does; the path is read at the pipeline's own time. Throws std::invalid_argument
+  // for a handle that does not fit the model.
+  virtual void set_drag(const DragHandle& d) = 0;
   // Largest node displacement |x_{n+1} - x_n| of the last step, computed where the state
   // lives; NaN when any position or velocity is not finite.
   virtual double max_displacement() = 0;
   // A timer of this pipeline's steps on the clock of the device that runs them (valid while
   // the pipeline lives). The default: the host clock, for pipelines that step on the host.
   virtual std::unique_ptr<StepTimer> step_timer() { return std::make_unique<HostStepTimer>(); }
+  // The OpenGL buffer holding the current positions, a vec4 per node (w: inverse mass), ready
+  // for GL to read: renderers draw from it without a copy. 0 where the state is not in GL.
+  virtual unsigned gl_position_buffer() { return 0; }
   // How the profiler's stage spans are timed ("host clock", "CUDA events", "GL timer queries").
   virtual std::string timing_method() const { return "host clock"; }
   // Pipelines that time their stages add spans (force, hand-off, update, ...) to `p` from

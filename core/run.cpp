@@ -92,11 +92,23 @@ class StepTimes {
 
 }  // namespace
 
+std::string divergence(double disp, const Model& m, const Params& p, Integrator i, int step, double t) {
+  const double runaway = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+  if (std::isfinite(disp) && disp <= runaway) return {};
+  std::ostringstream os;
+  os << "diverged at step " << step << " (t = " << t << " s): ";
+  if (!std::isfinite(disp))
+    os << "a position or velocity is not finite";
+  else
+    os << "a node moved " << disp << " m in one step, more than " << runaway << " m (runaway_factor x model extent)";
+  os << "; " << stability_hint(m, p, i);
+  return os.str();
+}
+
 RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions& opt) {
   using clock = std::chrono::steady_clock;
   RunResult r;
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
-  const double runaway = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   pipe.set_profiler(opt.profiler);
   StepTimes times(pipe, r, opt.profiler);
@@ -119,17 +131,8 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
       HostSpan span(opt.profiler, span::reductions);
       disp = pipe.max_displacement();
       r.last_displacement = disp;
-      if (!std::isfinite(disp) || disp > runaway) {
-        std::ostringstream os;
-        os << "diverged at step " << step << " (t = " << t << " s): ";
-        if (!std::isfinite(disp))
-          os << "a position or velocity is not finite";
-        else
-          os << "a node moved " << disp << " m in one step, more than " << runaway
-             << " m (runaway_factor x model extent)";
-        os << "; " << stability_hint(m, p, opt.integrator);
-        throw DivergenceError(step, os.str());
-      }
+      if (const std::string why = divergence(disp, m, p, opt.integrator, step, t); !why.empty())
+        throw DivergenceError(step, why);
     }
     r.records.push_back({step, t, std::numeric_limits<double>::quiet_NaN(), queue_ms, disp});
     times.after_step();

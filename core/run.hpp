@@ -25,6 +25,10 @@ double stability_limit(const Model& m, const Params& p, Integrator i);
 // What a divergence message says about the step: the bound and where dt lies against it.
 std::string stability_hint(const Model& m, const Params& p, Integrator i);
 
+// Empty when a step's largest displacement `disp` (Pipeline::max_displacement) is finite and
+// below the runaway limit, else the message naming the step, what was seen and the bound.
+std::string divergence(double disp, const Model& m, const Params& p, Integrator i, int step, double t);
+
 class DivergenceError : public std::runtime_error {
  public:
   DivergenceError(int step, const std::string& what) : std::runtime_error(what), step(step) {}

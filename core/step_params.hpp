@@ -12,6 +12,14 @@
 
 namespace deformlab {
 
+// The drag handle's part of the step parameters.
+template <class Real>
+void set_drag_params(typename Physics<Real>::StepParams& s, const DragHandle& d) {
+  s.drag_node = d.active() ? d.node : -1;
+  s.drag_mode = !d.active() ? DRAG_NONE : d.as_spring ? DRAG_SPRING : DRAG_HARD;
+  s.drag_stiffness = Real(d.stiffness);
+}
+
 template <class Real>
 typename Physics<Real>::StepParams step_params(const Model& m, const Params& p) {
   typename Physics<Real>::StepParams s{};
@@ -19,9 +27,7 @@ typename Physics<Real>::StepParams step_params(const Model& m, const Params& p) 
   s.dt = Real(p.dt);
   s.wind = vec3_cast<Real>(p.wind);
   s.damping = Real(p.damping);
-  s.drag_node = p.drag.active() ? p.drag.node : -1;
-  s.drag_mode = !p.drag.active() ? DRAG_NONE : p.drag.as_spring ? DRAG_SPRING : DRAG_HARD;
-  s.drag_stiffness = Real(p.drag.stiffness);
+  set_drag_params<Real>(s, p.drag);
   s.has_ground = p.ground ? 1 : 0;
   s.ground = Real(p.ground.value_or(0.f));
   if (p.spheres.size() > MAX_SPHERES)

@@ -292,8 +292,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   ~Impl() override {
-    for (auto& g : graph_)
-      if (g) cudaGraphExecDestroy(g);
+    drop_graphs();
+    if (copied_) cudaEventDestroy(copied_);
     if (stream_) cudaStreamDestroy(stream_);
   }
 
@@ -317,6 +317,21 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     s.v = download(v_[cur_]);
     if (sched_.rule == UpdateRule::verlet && has_prev_) s.x_prev = download(x_[1 - cur_]);
     return s;
+  }
+
+  void copy_positions(float4* dst, cudaStream_t stream) override {
+    if (!copied_) check(cudaEventCreateWithFlags(&copied_, cudaEventDisableTiming), "creating the copy event");
+    check(cudaEventRecord(copied_, stream_), "marking the step before a copy");
+    check(cudaStreamWaitEvent(stream, copied_, 0), "ordering a copy after the step");
+    check(cudaMemcpyAsync(dst, x_[cur_].get(), std::size_t(n_) * sizeof(float4), cudaMemcpyDeviceToDevice, stream),
+          "copying the positions");
+  }
+
+  void set_drag(const DragHandle& d) override {
+    validate(d, n_);
+    p_.drag = d;
+    set_drag_params<float>(sp_, d);
+    drop_graphs();  // their launches carry the old handle
   }
 
   void step() override {
@@ -431,6 +446,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Targets targets() const {
     if (!p_.drag.active()) return {};
     return {p_.drag.target(t_), p_.drag.target(t_ + p_.dt)};
+  }
+
+  void drop_graphs() {
+    for (auto& g : graph_) {
+      if (g) cudaGraphExecDestroy(g);
+      g = nullptr;
+    }
   }
 
   void capture(int parity) {
@@ -581,6 +603,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   std::unique_ptr<float4, FreeHost> staging_;
 
   cudaStream_t stream_ = nullptr;
+  cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
   cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;
@@ -594,6 +617,7 @@ class DeviceForcePass final : public ForcePass, private ForceKernels {
   void run(const float4* x, const float4* v, float4* acc, Vec3f drag_target, CUstream_st* stream) override {
     launch_forces(x, v, acc, drag_target, stream);
   }
+  void set_drag(const DragHandle& d) override { set_drag_params<float>(sp_, d); }
 };
 
 }  // namespace

@@ -18,6 +18,8 @@ class ForcePass {
   // velocities, acc accelerations; float4 arrays of the model's node count on the current
   // device. `drag_target`: the drag handle's target at the time of the forces.
   virtual void run(const float4* x, const float4* v, float4* acc, Vec3f drag_target, CUstream_st* stream) = 0;
+  // The drag handle's node and mode from the next run on (checked by the caller).
+  virtual void set_drag(const DragHandle& d) = 0;
 };
 
 // The naive, tiled or scatter force pass on the current device; throws std::invalid_argument

@@ -49,6 +49,7 @@ void GLAPIENTRY on_debug(GLenum, GLenum type, GLuint, GLenum severity, GLsizei, 
 
 class Context {
  public:
+  // The headless context: made here, current without a surface.
   Context() {
     display_ = open_display();
     if (!eglBindAPI(EGL_OPENGL_API)) fail(egl_error("eglBindAPI(EGL_OPENGL_API)"));
@@ -75,6 +76,44 @@ class Context {
            ": the driver may be too old for OpenGL 4.3");
     if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
       fail(egl_error("eglMakeCurrent without a surface"));
+    load_gl();
+    // A surfaceless context has no default framebuffer; every draw (transform feedback with
+    // the rasteriser discarded too) needs a complete framebuffer bound.
+    glGenFramebuffers(1, &fbo_);
+    glGenRenderbuffers(1, &rbo_);
+    glBindRenderbuffer(GL_RENDERBUFFER, rbo_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, 1, 1);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rbo_);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("the 1x1 framebuffer is incomplete");
+    glViewport(0, 0, 1, 1);
+    check("context setup");
+  }
+
+  // A window's context, made current on this thread by its window system, which keeps it.
+  explicit Context(const std::string& platform) {
+    info_.platform = platform;
+    load_gl();
+    check("context setup");
+  }
+
+  ~Context() {
+    if (context_ == EGL_NO_CONTEXT) return;
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display_, context_);
+    eglTerminate(display_);
+  }
+
+  const ContextInfo& info() const { return info_; }
+  void make_current() const {
+    if (context_ != EGL_NO_CONTEXT && eglGetCurrentContext() != context_ &&
+        !eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+      throw std::runtime_error(egl_error("eglMakeCurrent"));
+  }
+
+ private:
+  // The entry points and facts of the current context.
+  void load_gl() {
     // Debian's GLEW is built for GLX: under EGL glewInit loads every entry point and then
     // reports GLEW_ERROR_NO_GLX_DISPLAY, which is success here.
     glewExperimental = GL_TRUE;
@@ -102,35 +141,12 @@ class Context {
       glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
       glDebugMessageCallback(on_debug, nullptr);
     }
-    // A surfaceless context has no default framebuffer; every draw (transform feedback with
-    // the rasteriser discarded too) needs a complete framebuffer bound.
-    glGenFramebuffers(1, &fbo_);
-    glGenRenderbuffers(1, &rbo_);
-    glBindRenderbuffer(GL_RENDERBUFFER, rbo_);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, 1, 1);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rbo_);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("the 1x1 framebuffer is incomplete");
-    glViewport(0, 0, 1, 1);
-    check("context setup");
   }
 
-  ~Context() {
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(display_, context_);
-    eglTerminate(display_);
-  }
-
-  const ContextInfo& info() const { return info_; }
-  void make_current() const {
-    if (eglGetCurrentContext() != context_ && !eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
-      throw std::runtime_error(egl_error("eglMakeCurrent"));
-  }
-
- private:
   [[noreturn]] void fail(const std::string& why) {
     if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
     if (display_ != EGL_NO_DISPLAY) eglTerminate(display_);
+    context_ = EGL_NO_CONTEXT;
     throw std::invalid_argument("OpenGL unavailable: " + why);
   }
 
@@ -231,6 +247,12 @@ std::string unavailable_reason() {
   } catch (const std::exception& e) {
     return e.what();
   }
+}
+
+void adopt_current_context(const std::string& platform) {
+  Holder& h = holder();
+  if (h.ctx) throw std::logic_error("an OpenGL context is already in use");
+  h.ctx = std::make_unique<Context>(platform);
 }
 
 bool context_created() { return bool(holder().ctx); }

@@ -35,6 +35,10 @@ struct ContextInfo {
 const ContextInfo& context();
 // Empty when a context can be made here, else the reason it cannot.
 std::string unavailable_reason();
+// Takes the context current on this thread (a window's, made and kept by a window system) as
+// the process's context instead of the headless one; `platform` names it for manifests. Call
+// before any other GL use; throws std::invalid_argument when it is older than 4.3 core.
+void adopt_current_context(const std::string& platform);
 // True once a context exists (so that manifests can report it without creating one).
 bool context_created();
 

@@ -167,6 +167,14 @@ void GlPipeline::make_buffers() {
   }
 }
 
+void GlPipeline::set_drag(const DragHandle& d) {
+  validate(d, n_);
+  const bool same = d.active() == p_.drag.active() && d.node == p_.drag.node && d.as_spring == p_.drag.as_spring &&
+                    d.stiffness == p_.drag.stiffness;
+  p_.drag = d;
+  if (!same) upload_params();  // the targets are uniforms set at each pass
+}
+
 void GlPipeline::upload_params() {
   SimBlock u{};
   u.params = step_params<float>(m_, p_);
@@ -423,7 +431,7 @@ void GlPipeline::bind_terms(const std::function<void(int count, int stride, int 
   }
 }
 
-GLuint GlPipeline::position_buffer() {
+unsigned GlPipeline::gl_position_buffer() {
   context();
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   return x_[cur_].id();

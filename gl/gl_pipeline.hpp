@@ -39,6 +39,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   ~GlPipeline() override;
   void set_state(const State& s) override;
   State state() override;
+  void set_drag(const DragHandle& d) override;
   void step() override;  // the schedule's passes with the forces in the shaders, then finish_step()
   // The shaders evaluate a force pass inside the GPU pass of the update that follows it:
   // this records the time of those forces.
@@ -58,8 +59,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::string timing_method() const override { return spans_.method(); }
   std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<QueryStepTimer>(); }
 
-  // The current positions, one vec4 per node (w: inverse mass), ready to be read by GL.
-  GLuint position_buffer();
+  unsigned gl_position_buffer() override;
   // While profiled, each step's passes are one force+update span timed by the GL clock
   // (without an outside force stage, whose pipeline times the passes itself).
   void set_profiler(Profiler* p) override;
@@ -138,7 +138,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   void require_memory(std::int64_t bytes) const;
 
   const Model& m_;
-  const Params p_;
+  Params p_;
   const UpdateRule rule_;
   Schedule sched_;
   std::vector<GpuPass> passes_;

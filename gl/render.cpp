@@ -47,6 +47,38 @@ GLint bound_framebuffer(GLenum which = GL_DRAW_FRAMEBUFFER_BINDING) {
 
 }  // namespace
 
+std::pair<Vec3f, Vec3f> Camera::ray(double px, double py, int w, int h) const {
+  const Vec3f f = normalized(target - eye), s = normalized(cross(f, up)), u = cross(s, f);
+  const float t = std::tan(fovy / 2), aspect = float(w) / float(h);
+  const float nx = float(2 * px / w - 1), ny = float(1 - 2 * py / h);
+  return {eye, normalized(f + s * (nx * t * aspect) + u * (ny * t))};
+}
+
+std::array<double, 2> Camera::pixel(Vec3f x, int w, int h) const {
+  const Vec3f f = normalized(target - eye), s = normalized(cross(f, up)), u = cross(s, f);
+  const Vec3f d = x - eye;
+  const double t = std::tan(fovy / 2), aspect = double(w) / h, depth = dot(d, f);
+  if (!(depth > 0)) return {std::nan(""), std::nan("")};  // behind the eye
+  const double nx = dot(d, s) / (depth * t * aspect), ny = dot(d, u) / (depth * t);
+  return {(nx + 1) * w / 2, (1 - ny) * h / 2};
+}
+
+Camera framing(const Model& m, std::optional<float> ground) {
+  Vec3f lo = m.rest_position[0], hi = lo;
+  for (const auto& p : m.rest_position)
+    for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+  lo.y -= 0.6f * std::max({hi.x - lo.x, hi.z - lo.z});
+  if (ground) {
+    const Vec3f half = (hi - lo) * 0.5f;
+    lo = lo - Vec3f{half.x, 0.f, half.z};
+    hi = hi + Vec3f{half.x, 0.f, half.z};
+    lo.y = std::min(lo.y, *ground - 0.05f * (hi.y - lo.y));
+  }
+  const Vec3f centre = (lo + hi) * 0.5f;
+  const float radius = std::max(0.5f * norm(hi - lo), 1e-3f);
+  return {centre + Vec3f{0.f, 0.9f, 2.2f} * radius, centre};
+}
+
 struct Renderer::Impl {
   const Model& m;
   RenderOptions o;
@@ -67,20 +99,48 @@ struct Renderer::Impl {
   };
   std::vector<Band> bands;
   int stride = 1;  // surface: every stride-th row and column (a frame shows no more)
-  Mat4 view_proj{};
-  Vec3f eye;
+  Camera camera;
+  bool wireframe = false;
+  GLint texels = 0, align = 16;
   Timer timer;
 
-  Impl(const Model& model, RenderOptions opt) : m(model), o(opt) {
+  Impl(const Model& model, RenderOptions opt) : m(model), o(opt), camera(framing(model, opt.ground)) {
+    make_framebuffer();
+    prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
+    GLuint id = 0;
+    glGenVertexArrays(1, &id);
+    vao = VertexArray(id);
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+    glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &align);
+    set_mode(o.mode);
+    check("renderer setup");
+  }
+
+  void set_mode(RenderOptions::Mode mode) {
+    const bool surface_wanted = mode == RenderOptions::Mode::surface ||
+                                (mode == RenderOptions::Mode::automatic &&
+                                 (m.topology == Topology::cloth_grid || !m.triangle.empty()));
+    const bool want_mesh = surface_wanted && !m.triangle.empty(), want_surface = surface_wanted && !want_mesh;
+    if (want_surface && (m.topology != Topology::cloth_grid || m.nx < 2 || m.ny < 2))
+      throw std::invalid_argument("surface rendering needs a cloth grid of at least 2x2 nodes or a mesh's triangles");
+    o.mode = mode;
+    mesh = want_mesh;
+    surface = want_surface;
+    bands.clear();
+    plan_bands(o.band_texels > 0 ? std::min<std::int64_t>(o.band_texels, texels) : texels,
+               std::lcm(std::max(align, 1), 16) / 16);
+    if (mesh) {
+      if (bands.size() > 1)
+        throw std::invalid_argument("a mesh of " + std::to_string(m.node_count()) +
+                                    " nodes is more than one texture buffer holds (" + std::to_string(texels) +
+                                    " texels): draw it as points");
+      if (!elements) elements = make_buffer(m.triangle.size() * sizeof(std::int32_t), m.triangle.data());
+    }
+  }
+
+  void make_framebuffer() {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
       throw std::invalid_argument("frame size must be between 1 and 16384 pixels");
-    const bool surface_wanted = o.mode == RenderOptions::Mode::surface ||
-                                (o.mode == RenderOptions::Mode::automatic &&
-                                 (m.topology == Topology::cloth_grid || !m.triangle.empty()));
-    mesh = surface_wanted && !m.triangle.empty();
-    surface = surface_wanted && !mesh;
-    if (surface && (m.topology != Topology::cloth_grid || m.nx < 2 || m.ny < 2))
-      throw std::invalid_argument("surface rendering needs a cloth grid of at least 2x2 nodes or a mesh's triangles");
     GLuint id = 0;
     glGenRenderbuffers(1, &id);
     color = Renderbuffer(id);
@@ -99,40 +159,14 @@ struct Renderer::Impl {
     const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     if (!complete) throw std::runtime_error("the render framebuffer is incomplete");
-    prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
-    glGenVertexArrays(1, &id);
-    vao = VertexArray(id);
-    GLint texels = 0, align = 16;
-    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
-    glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &align);
-    plan_bands(o.band_texels > 0 ? std::min<std::int64_t>(o.band_texels, texels) : texels,
-               std::lcm(std::max(align, 1), 16) / 16);
-    if (mesh) {
-      if (bands.size() > 1)
-        throw std::invalid_argument("a mesh of " + std::to_string(m.node_count()) +
-                                    " nodes is more than one texture buffer holds (" + std::to_string(texels) +
-                                    " texels): draw it as points");
-      elements = make_buffer(m.triangle.size() * sizeof(std::int32_t), m.triangle.data());
-    }
-    // Camera: in front of and above the rest shape and the space below it where a pinned
-    // model hangs, looking at the centre of both.
-    Vec3f lo = m.rest_position[0], hi = lo;
-    for (const auto& p : m.rest_position)
-      for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
-    lo.y -= 0.6f * std::max({hi.x - lo.x, hi.z - lo.z});
-    if (o.ground) {  // dropped onto the ground: down to it, and half the model's size to each side
-      const Vec3f half = (hi - lo) * 0.5f;
-      lo = lo - Vec3f{half.x, 0.f, half.z};
-      hi = hi + Vec3f{half.x, 0.f, half.z};
-      lo.y = std::min(lo.y, *o.ground - 0.05f * (hi.y - lo.y));
-    }
-    const Vec3f centre = (lo + hi) * 0.5f;
-    const float radius = std::max(0.5f * norm(hi - lo), 1e-3f);
-    eye = centre + Vec3f{0.f, 0.9f, 2.2f} * radius;
-    const float dist = norm(eye - centre);
-    view_proj = mul(perspective(0.8f, float(o.width) / float(o.height), dist * 0.05f, dist * 4.f),
-                    look_at(eye, centre, {0.f, 1.f, 0.f}));
-    check("renderer setup");
+  }
+
+  // Near and far planes at 0.05 and 4 x the eye's distance from the target (surface_at
+  // inverts this projection).
+  Mat4 view_proj() const {
+    const float dist = norm(camera.eye - camera.target);
+    return mul(perspective(camera.fovy, float(o.width) / float(o.height), dist * 0.05f, dist * 4.f),
+               look_at(camera.eye, camera.target, camera.up));
   }
 
   // Splits the drawing into bands whose positions fit in one texture buffer view of at most
@@ -168,14 +202,16 @@ struct Renderer::Impl {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_PROGRAM_POINT_SIZE);
+    if (wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     glUseProgram(prog.id());
-    glUniformMatrix4fv(uniform(prog.id(), "u_view_proj"), 1, GL_FALSE, view_proj.data());
+    const Mat4 vp = view_proj();
+    glUniformMatrix4fv(uniform(prog.id(), "u_view_proj"), 1, GL_FALSE, vp.data());
     glUniform2i(uniform(prog.id(), "u_grid"), m.nx, m.ny);
     glUniform1i(uniform(prog.id(), "u_surface"), surface ? 1 : 0);
     glUniform1i(uniform(prog.id(), "u_mesh"), mesh ? 1 : 0);
     glUniform1f(uniform(prog.id(), "u_point_size"),
                 std::clamp(float(o.width) / std::sqrt(float(m.node_count())) * 0.4f, 1.f, 8.f));
-    glUniform3f(uniform(prog.id(), "u_eye"), eye.x, eye.y, eye.z);
+    glUniform3f(uniform(prog.id(), "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
     glUniform1i(uniform(prog.id(), "u_stride"), stride);
     if (!draw_tex) draw_tex = make_texture();
     glActiveTexture(GL_TEXTURE0);
@@ -198,6 +234,7 @@ struct Renderer::Impl {
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     timer.end();
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     check("rendering a frame");
@@ -219,10 +256,15 @@ Renderer::~Renderer() = default;
 
 void Renderer::draw(Pipeline& p) {
   context();
-  if (auto* g = dynamic_cast<GlPipeline*>(&p))
-    impl_->draw_buffer(g->position_buffer());
+  if (const GLuint b = p.gl_position_buffer())
+    impl_->draw_buffer(b);
   else
     draw(p.state());
+}
+
+void Renderer::draw_positions(unsigned buffer) {
+  context();
+  impl_->draw_buffer(buffer);
 }
 
 void Renderer::draw(const State& s) {
@@ -274,6 +316,45 @@ std::vector<double> Renderer::take_draw_ms() { return impl_->timer.take(); }
 std::string Renderer::timing_method() const { return impl_->timer.method(); }
 int Renderer::width() const { return impl_->o.width; }
 int Renderer::height() const { return impl_->o.height; }
+const Camera& Renderer::camera() const { return impl_->camera; }
+void Renderer::set_camera(const Camera& c) { impl_->camera = c; }
+void Renderer::set_wireframe(bool on) { impl_->wireframe = on; }
+unsigned Renderer::framebuffer() const { return impl_->fbo.id(); }
+
+std::optional<Vec3f> Renderer::surface_at(double px, double py) {
+  context();
+  const Impl& r = *impl_;
+  const int x = int(px), y = r.o.height - 1 - int(py);
+  if (x < 0 || y < 0 || x >= r.o.width || y >= r.o.height) return std::nullopt;
+  float depth = 1.f;
+  const GLint previous = bound_framebuffer(GL_READ_FRAMEBUFFER_BINDING);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo.id());
+  glReadPixels(x, y, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &depth);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(previous));
+  check("reading the depth under the cursor");
+  if (!(depth < 1.f)) return std::nullopt;
+  // The view distance along the camera's axis from the depth (the projection of view_proj()).
+  const Camera& c = r.camera;
+  const float dist = norm(c.eye - c.target), n = dist * 0.05f, f = dist * 4.f;
+  const float z_ndc = 2.f * depth - 1.f, z = 2.f * f * n / ((f + n) - z_ndc * (f - n));
+  const auto [o, d] = c.ray(px, py, r.o.width, r.o.height);
+  return o + d * (z / dot(d, normalized(c.target - c.eye)));
+}
+
+void Renderer::set_mode(RenderOptions::Mode m) {
+  context();
+  impl_->set_mode(m);
+}
+
+void Renderer::resize(int width, int height) {
+  context();
+  if (width == impl_->o.width && height == impl_->o.height) return;
+  impl_->o.width = width;
+  impl_->o.height = height;
+  impl_->make_framebuffer();
+  impl_->set_mode(impl_->o.mode);  // a cloth's sampling follows the frame size
+  check("resizing the frame");
+}
 
 FrameWriter::FrameWriter(const Model& m, std::filesystem::path dir, int every, RenderOptions o)
     : r_(m, o), dir_(std::move(dir)), every_(every) {

@@ -3,11 +3,13 @@
 // Works for every pipeline: GL pipelines are drawn from their own buffers, others uploaded.
 #pragma once
 #include <cstdint>
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/model.hpp"
@@ -29,9 +31,27 @@ struct RenderOptions {
   std::optional<float> ground;
 };
 
+// A perspective camera: where it is, what it looks at, its up direction and vertical field of
+// view (radians).
+struct Camera {
+  Vec3f eye, target, up{0.f, 1.f, 0.f};
+  float fovy = 0.8f;
+
+  // The ray through pixel (px, py) (from the top left; pixel centres at .5) of a w x h view:
+  // the eye and a unit direction.
+  std::pair<Vec3f, Vec3f> ray(double px, double py, int w, int h) const;
+  // The pixel (from the top left) where `x` appears in a w x h view; NaN behind the eye.
+  std::array<double, 2> pixel(Vec3f x, int w, int h) const;
+};
+
+// In front of and above the model's rest shape and the space below it where a pinned model
+// hangs, looking at the centre of both; with a ground, down to it and half the model's width
+// to each side (a model dropped onto it stays in view).
+Camera framing(const Model& m, std::optional<float> ground);
+
 class Renderer {
  public:
-  // The camera frames the model's rest positions and stays fixed.
+  // The camera starts at framing(m, o.ground).
   Renderer(const Model& m, RenderOptions o = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -39,6 +59,8 @@ class Renderer {
 
   // Draws the pipeline's current state (a GL pipeline's buffers, any other's state()).
   void draw(Pipeline& p);
+  // Draws positions from a GL buffer: a vec4 per node (w unused).
+  void draw_positions(unsigned buffer);
   void draw(const State& s);
   // RGBA8, rows from the top.
   std::vector<std::uint8_t> pixels();
@@ -48,6 +70,17 @@ class Renderer {
   std::string timing_method() const;
   int width() const;
   int height() const;
+
+  // For interactive views.
+  const Camera& camera() const;
+  void set_camera(const Camera& c);
+  void set_mode(RenderOptions::Mode m);  // throws std::invalid_argument where the model has no surface
+  void set_wireframe(bool on);           // surfaces as their edges
+  void resize(int width, int height);
+  unsigned framebuffer() const;          // the GL framebuffer drawn into (colour attachment 0)
+  // The point of the model drawn under pixel (px, py) (from the top left) in the last frame,
+  // from its depth buffer; none over the background.
+  std::optional<Vec3f> surface_at(double px, double py);
 
  private:
   struct Impl;

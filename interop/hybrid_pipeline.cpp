@@ -61,12 +61,18 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
 
   void set_state(const State& s) override { gl_->set_state(s); }
   State state() override { return gl_->state(); }
+  void set_drag(const DragHandle& d) override {
+    gl_->set_drag(d);  // checks it
+    fp_->set_drag(d);
+    p_.drag = d;
+  }
   void step() override {
     run_passes(sched_, gl_->time(), p_.dt, *this, *this);
     gl_->finish_step();
     if (prof_ && force_spans_.pending() > 512) collect();
   }
   double max_displacement() override { return gl_->max_displacement(); }
+  unsigned gl_position_buffer() override { return gl_->gl_position_buffer(); }
   std::string timing_method() const override {
     return "CUDA events (force), " + gl::Timer().method() + " (update), host clock (hand-off)";
   }
