@@ -23,6 +23,15 @@ struct RunArgs {
   bool no_state = false;         // leave out state.ply
 };
 
+struct ViewArgs {
+  RunArgs run;  // the scene, pipeline and stepping flags `run` shares
+  int steps_per_frame = 10;
+  std::string size = "1280x800";  // the window, WxH
+  std::optional<std::string> script, save_script, record, summary;
+  std::optional<double> seconds;  // with --record: seconds of video, then quit
+  std::optional<int> max_frames;  // quit after this many frames
+};
+
 struct CalibrateArgs {
   std::vector<std::string> argv;
   std::optional<std::string> out;  // JSON file (default: stdout)
@@ -45,6 +54,7 @@ int run_command(const RunArgs& a);
 int experiment_command(const ExperimentArgs& a);
 int list_command();
 int calibrate_command(const CalibrateArgs& a);
+int view_command(const ViewArgs& a);
 
 // This device's calibration (interop/calibrate.hpp) with the build, machine and `argv`;
 // throws std::invalid_argument where it cannot be measured (no CUDA, no GL, ...).

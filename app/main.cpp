@@ -63,6 +63,26 @@ int main(int argc, char** argv) {
 
   auto* list = cli.add_subcommand("list", "List pipelines and integrators, and which run here");
 
+  deformlab::app::ViewArgs v;
+  v.run.argv = a.argv;
+  auto* view = cli.add_subcommand("view", "Open the simulation in a window: pick and drag nodes, switch stages live");
+  view->add_option("--experiment", v.run.experiment, "Experiment file or built-in name (default: paper-drag)");
+  view->add_option("--scene", v.run.scene, "Scene file overriding the experiment's scene");
+  view->add_option("--pipeline,-p", v.run.pipeline, "Pipeline name ('deformlab list'), or 'best'");
+  view->add_option("--integrator,-i", v.run.integrator, "Integrator name ('deformlab list')");
+  auto* view_grid = view->add_option("--grid", v.run.grid, "Cloth grid size WxH, e.g. 128x128");
+  view->add_option("--lattice", v.run.lattice, "Lattice size WxHxD, e.g. 8x8x8")->excludes(view_grid);
+  view->add_option("--dt", v.run.dt, "Time step, s");
+  view->add_option("--option", v.run.options, "Pipeline option NAME=VALUE (repeatable)");
+  view->add_option("--steps-per-frame", v.steps_per_frame, "Steps between drawn frames (default 10)");
+  view->add_option("--size", v.size, "Size of the 3D view WxH in pixels (the panel adds its width; default 1280x800)");
+  view->add_option("--script", v.script, "Replay the input events of a script file (see --save-script)");
+  view->add_option("--save-script", v.save_script, "Save this session's input events as a script file at the end");
+  view->add_option("--record", v.record, "Record the window as an MP4 (H.264, 30 frames a second, one per frame drawn)");
+  view->add_option("--seconds", v.seconds, "With --record: record this many seconds of video, then quit");
+  view->add_option("--max-frames", v.max_frames, "Quit after this many frames");
+  view->add_option("--summary", v.summary, "Write a JSON summary of the session (drags, switches, screenshots) at the end");
+
   deformlab::app::CalibrateArgs cal;
   cal.argv = a.argv;
   auto* calibrate = cli.add_subcommand(
@@ -83,5 +103,6 @@ int main(int argc, char** argv) {
   if (*experiment) return deformlab::app::experiment_command(ex);
   if (*list) return deformlab::app::list_command();
   if (*calibrate) return deformlab::app::calibrate_command(cal);
+  if (*view) return deformlab::app::view_command(v);
   return 2;
 }

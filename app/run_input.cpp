@@ -19,24 +19,6 @@ struct BadInput : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-// "128x96" -> {128, 96}; `dims` numbers, each a positive integer.
-std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
-  const std::string pat = dims == 2 ? "WxH" : "WxHxD";
-  std::vector<int> out;
-  std::stringstream ss(s);
-  for (std::string part; std::getline(ss, part, 'x');) {
-    if (part.empty() || !std::all_of(part.begin(), part.end(), ::isdigit))
-      throw BadInput(std::string(flag) + " '" + s + "': expected " + pat + " with positive integers");
-    const long long v = std::stoll(part.size() > 12 ? std::string("9999999999999") : part);
-    if (v <= 0 || v > 1'000'000'000)
-      throw BadInput(std::string(flag) + " '" + s + "': each size must be between 1 and 10^9");
-    out.push_back(int(v));
-  }
-  if (int(out.size()) != dims || s.back() == 'x')
-    throw BadInput(std::string(flag) + " '" + s + "': expected " + pat);
-  return out;
-}
-
 // The GL flags, then the experiment (or the default one) with --scene, --pipeline and
 // --integrator applied.
 Experiment read_experiment(const RunArgs& a) {
@@ -109,6 +91,23 @@ void check_fits(const RunInput& in, bool compare, const ModelSize& size) {
 }
 
 }  // namespace
+
+std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
+  const std::string pat = dims == 2 ? "WxH" : "WxHxD";
+  std::vector<int> out;
+  std::stringstream ss(s);
+  for (std::string part; std::getline(ss, part, 'x');) {
+    if (part.empty() || !std::all_of(part.begin(), part.end(), ::isdigit))
+      throw std::invalid_argument(std::string(flag) + " '" + s + "': expected " + pat + " with positive integers");
+    const long long v = std::stoll(part.size() > 12 ? std::string("9999999999999") : part);
+    if (v <= 0 || v > 1'000'000'000)
+      throw std::invalid_argument(std::string(flag) + " '" + s + "': each size must be between 1 and 10^9");
+    out.push_back(int(v));
+  }
+  if (int(out.size()) != dims || s.back() == 'x')
+    throw std::invalid_argument(std::string(flag) + " '" + s + "': expected " + pat);
+  return out;
+}
 
 RunInput read_run_input(const RunArgs& a) {
   RunInput in;

@@ -19,6 +19,9 @@ struct RunInput {
   double build_s = 0.0;  // building the model, host clock
 };
 
+// "128x96" -> {128, 96}: `dims` positive integers; throws std::invalid_argument naming `flag`.
+std::vector<int> parse_size(const std::string& s, int dims, const char* flag);
+
 // Reads the experiment or scene, applies the flags and builds the model; bad input
 // (unknown names, bad sizes or numbers, a model too large for memory) throws
 // std::invalid_argument with one line saying what is wrong.

@@ -7,7 +7,7 @@ preset=${1:-default}
 
 packages=(cmake g++ make pkg-config git libeigen3-dev libgtest-dev libcli11-dev nlohmann-json3-dev
           libomp-dev libglew-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libstb-dev libvulkan-dev
-          libassimp-dev libgmsh-dev)
+          libassimp-dev libgmsh-dev libglfw3-dev libimgui-dev xvfb xauth ffmpeg)
 [ "$preset" = fuzz ] && packages+=(clang libclang-rt-14-dev)  # libFuzzer
 missing=()
 for p in "${packages[@]}"; do

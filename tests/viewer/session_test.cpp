@@ -1,0 +1,184 @@
+// The viewer's simulation without a window: pipelines replaced mid-run with the state carried
+// over, the drag handle of picking, pins toggled, reset; picking and the camera's moves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/run.hpp"
+#include "experiments/pipelines.hpp"
+#include "gl/context.hpp"
+#include "gl/render.hpp"
+#include "tests/support/test_states.hpp"
+#include "viewer/orbit.hpp"
+#include "viewer/session.hpp"
+
+namespace deformlab::test {
+namespace {
+
+using viewer::Session;
+
+Session cloth_session(const std::string& pipeline, int side = 12) {
+  Model m = small_cloth(side, side);
+  m.damping = {0.02f, 0.02f, 0.01f};
+  return Session({std::move(m), small_params(), pipelines().find(pipeline), Integrator::semi_implicit_euler, {}});
+}
+
+TEST(ViewerSession, ReplacedPipelineContinuesTheTrajectory) {
+  // cpu -> omp -> cpu, with a dt change on the way: omp is bitwise cpu, so the result equals
+  // cpu run all along with the same dt change.
+  Session s = cloth_session("cpu"), plain = cloth_session("cpu");
+  s.step(10);
+  plain.step(10);
+  ASSERT_EQ(s.replace(*pipelines().find("omp"), Integrator::semi_implicit_euler, {}, 0.002f), "");
+  EXPECT_TRUE(s.carried_exactly());
+  EXPECT_EQ(s.entry().name, "omp");
+  ASSERT_EQ(plain.replace(*pipelines().find("cpu"), Integrator::semi_implicit_euler, {}, 0.002f), "");
+  s.step(10);
+  plain.step(10);
+  ASSERT_EQ(s.replace(*pipelines().find("cpu"), Integrator::semi_implicit_euler, {}, 0.002f), "");
+  s.step(5);
+  plain.step(5);
+  EXPECT_TRUE(bitwise_equal(s.pipeline().state(), plain.pipeline().state()));
+  EXPECT_EQ(s.steps(), 25);
+  EXPECT_NEAR(s.time(), 10 * 0.001 + 15 * 0.002, 1e-8);
+}
+
+TEST(ViewerSession, EveryAvailablePipelineTakesTheStateExactly) {
+  Session s = cloth_session("cpu");
+  s.step(7);
+  for (const PipelineEntry& e : pipelines().all()) {
+    if (!e.unavailable().empty()) continue;
+    const State before = s.pipeline().state();
+    ASSERT_EQ(s.replace(e, Integrator::semi_implicit_euler, {}, s.params().dt), "") << e.name;
+    EXPECT_TRUE(s.carried_exactly()) << e.name;
+    EXPECT_TRUE(bitwise_equal(s.pipeline().state(), before)) << e.name;
+    s.step(3);
+  }
+}
+
+TEST(ViewerSession, AReplacementThatCannotBeMadeKeepsThePipeline) {
+  Session s = cloth_session("cpu");
+  s.step(3);
+  const State before = s.pipeline().state();
+  const std::string why = s.replace(*pipelines().find("omp"), Integrator::semi_implicit_euler, {}, -1.f);
+  EXPECT_NE(why.find("dt"), std::string::npos) << why;
+  EXPECT_EQ(s.entry().name, "cpu");
+  EXPECT_TRUE(bitwise_equal(s.pipeline().state(), before));
+}
+
+TEST(ViewerSession, DraggedNodeSitsOnItsTargetAndMovesOnceReleased) {
+  Session s = cloth_session("cpu");
+  const int node = 6 * 12 + 6;
+  const Vec3f target = s.model().rest_position[node] + Vec3f{0.05f, 0.1f, 0.f};
+  s.drag(node, target);
+  s.step(5);
+  EXPECT_EQ(s.pipeline().state().x[node], target);
+  EXPECT_EQ(s.dragged(), node);
+  s.release();
+  s.step(5);
+  EXPECT_LT(s.pipeline().state().x[node].y, target.y) << "released, it falls";
+  EXPECT_EQ(s.dragged(), -1);
+}
+
+TEST(ViewerSession, PinsHoldAndFreeNodesAndResetRestoresTheScene) {
+  Session s = cloth_session("cpu");
+  const int node = 5 * 12 + 4;
+  s.step(5);
+  const Vec3f held = s.pipeline().state().x[node];
+  s.toggle_pin(node);
+  EXPECT_TRUE(s.model().pinned(node));
+  s.step(20);
+  EXPECT_EQ(s.pipeline().state().x[node], held);
+  s.toggle_pin(node);
+  EXPECT_FALSE(s.model().pinned(node));
+  s.step(20);
+  EXPECT_NE(s.pipeline().state().x[node], held);
+  s.toggle_pin(0);  // a corner the scene pins: freed with the free nodes' mean inverse mass
+  EXPECT_FALSE(s.model().pinned(0));
+  s.step(5);
+  EXPECT_NE(s.pipeline().state().x[0], s.model().rest_position[0]);
+  s.reset();
+  EXPECT_TRUE(s.model().pinned(0));
+  EXPECT_EQ(s.steps(), 0);
+  EXPECT_TRUE(bitwise_equal(s.pipeline().state(), rest_state(s.model())));
+}
+
+TEST(ViewerSession, DivergenceIsReportedNotCrashed) {
+  Model m = small_cloth(8, 8);
+  Params p = small_params();
+  p.dt = 0.05f;  // far beyond the explicit bound of these springs
+  Session s({std::move(m), p, pipelines().find("cpu"), Integrator::explicit_euler, {}});
+  try {
+    for (int k = 0; k < 200; ++k) s.step(10);
+    FAIL() << "did not diverge";
+  } catch (const DivergenceError& e) {
+    EXPECT_NE(std::string(e.what()).find("diverged at step"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ViewerPicking, FindsTheNodeNearestTheCursorOnScreen) {
+  const Model m = small_cloth(10, 10);
+  const gl::Camera c = gl::framing(m, std::nullopt);
+  const int w = 640, h = 480;
+  auto pixel = [&](Vec3f x) { return c.pixel(x, w, h); };
+  for (int node : {0, 37, 55, 99}) {
+    const auto p = pixel(m.rest_position[node]);
+    EXPECT_EQ(viewer::pick_node(m.rest_position, p[0] + 1, p[1] - 1, 4.0, pixel), node);
+  }
+  EXPECT_EQ(viewer::pick_node(m.rest_position, 2, 2, 4.0, pixel), -1) << "nothing in the corner";
+  EXPECT_EQ(viewer::nearest_node(m.rest_position, m.rest_position[42] + Vec3f{0.01f, 0.f, -0.01f}), 42);
+}
+
+// The depth under the cursor gives the point of the surface there, on the node drawn there.
+TEST(ViewerPicking, SurfaceUnderTheCursorIsWhereTheNodeIs) {
+  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
+  const Model m = small_cloth(20, 20);
+  gl::Renderer r(m, {.width = 400, .height = 300});
+  r.draw(rest_state(m));
+  const gl::Camera& c = r.camera();
+  for (int node : {20 * 10 + 10, 20 * 3 + 15, 20 * 16 + 4}) {
+    const Vec3f x = m.rest_position[node];
+    const auto p = c.pixel(x, 400, 300);
+    const std::optional<Vec3f> at = r.surface_at(p[0], p[1]);
+    ASSERT_TRUE(at) << node;
+    EXPECT_LT(norm(*at - x), 0.01f) << node << ": depth quantisation and the pixel's centre, 0.05 m spacing";
+    EXPECT_EQ(viewer::nearest_node(m.rest_position, *at), node);
+  }
+  EXPECT_FALSE(r.surface_at(2, 2)) << "background";
+}
+
+TEST(ViewerCamera, RaysAndPixelsAgreeAndMovesKeepTheirShape) {
+  const Model m = small_cloth(10, 10);
+  gl::Camera c = gl::framing(m, std::nullopt);
+  const int w = 800, h = 600;
+  const auto [o, d] = c.ray(123.5, 456.25, w, h);
+  const auto p = c.pixel(o + d * 1.7f, w, h);
+  EXPECT_NEAR(p[0], 123.5, 1e-3);
+  EXPECT_NEAR(p[1], 456.25, 1e-3);
+  EXPECT_TRUE(std::isnan(c.pixel(o - d, w, h)[0])) << "behind the eye";
+
+  const float dist = norm(c.eye - c.target);
+  viewer::orbit(c, 0.7f, 0.3f);
+  EXPECT_NEAR(norm(c.eye - c.target), dist, 1e-5 * dist);
+  viewer::orbit(c, 0.f, 10.f);  // stops short of the pole
+  EXPECT_GT(norm(cross(c.eye - c.target, c.up)), 0.01f * dist);
+  const Vec3f target = c.target;
+  const auto before = c.pixel(target, w, h);
+  viewer::pan(c, 40.f, -25.f, h);
+  const auto after = c.pixel(target, w, h);  // the old target follows the cursor
+  EXPECT_NEAR(after[0] - before[0], 40.0, 1e-2);
+  EXPECT_NEAR(after[1] - before[1], -25.0, 1e-2);
+  viewer::zoom(c, 0.5f);
+  EXPECT_NEAR(norm(c.eye - c.target), 0.5f * dist, 1e-5 * dist);
+}
+
+TEST(ViewerPlane, RayMeetsThePlaneOnIt) {
+  const Vec3f hit = viewer::on_plane({0, 0, 5}, {0, 0.6f, -0.8f}, {1, 2, 1}, {0, 0, 1});
+  EXPECT_NEAR(hit.z, 1.f, 1e-6f);
+  EXPECT_NEAR(hit.y, 3.f, 1e-6f);
+  const Vec3f along = viewer::on_plane({0, 0, 5}, {1, 0, 0}, {1, 2, 1}, {0, 0, 1});
+  EXPECT_EQ(along, (Vec3f{1, 2, 1})) << "a ray along the plane keeps the point";
+}
+
+}  // namespace
+}  // namespace deformlab::test

@@ -1,0 +1,62 @@
+#include "recorder.hpp"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <utility>
+
+namespace deformlab::viewer {
+namespace {
+
+std::string shell_quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+}  // namespace
+
+Recorder::Recorder(std::string file, int width, int height, int fps)
+    : file_(std::move(file)), partial_(file_ + ".partial-" + std::to_string(getpid())), w_(width), h_(height) {
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
+    throw std::invalid_argument("recording needs ffmpeg, which is not installed");
+  const auto dir = std::filesystem::path(file_).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir))
+    throw std::invalid_argument("cannot record into " + file_ + ": no folder " + dir.string());
+  std::signal(SIGPIPE, SIG_IGN);  // a failed ffmpeg shows as a write error, not a dead viewer
+  // H.264 in yuv420p wants even sizes: an odd last row or column is cut.
+  const std::string cmd = "ffmpeg -loglevel error -y -f rawvideo -pix_fmt rgba -s " + std::to_string(w_) + "x" +
+                          std::to_string(h_) + " -r " + std::to_string(fps) +
+                          " -i - -vf 'vflip,crop=trunc(iw/2)*2:trunc(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -f mp4 " +
+                          shell_quoted(partial_);
+  pipe_ = popen(cmd.c_str(), "w");
+  if (!pipe_) throw std::runtime_error("cannot start ffmpeg");
+}
+
+Recorder::~Recorder() {
+  if (!pipe_) return;
+  pclose(pipe_);
+  std::filesystem::remove(partial_);
+}
+
+void Recorder::add(const std::vector<std::uint8_t>& rgba) {
+  if (!pipe_) throw std::logic_error("the recording is finished");
+  if (rgba.size() != std::size_t(w_) * h_ * 4) throw std::logic_error("a frame of the wrong size");
+  if (std::fwrite(rgba.data(), 1, rgba.size(), pipe_) != rgba.size())
+    throw std::runtime_error("ffmpeg stopped taking frames for " + file_);
+  ++frames_;
+}
+
+void Recorder::finish() {
+  const int status = pclose(std::exchange(pipe_, nullptr));
+  if (status != 0 || frames_ == 0) {
+    std::filesystem::remove(partial_);
+    throw std::runtime_error("ffmpeg could not write " + file_);
+  }
+  std::filesystem::rename(partial_, file_);
+}
+
+}  // namespace deformlab::viewer

@@ -1,0 +1,106 @@
+#include "script.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "core/json_file.hpp"
+
+namespace deformlab::viewer {
+namespace {
+
+const std::pair<const char*, Event::Kind> kKinds[] = {
+    {"press", Event::Kind::press}, {"move", Event::Kind::move},   {"release", Event::Kind::release},
+    {"scroll", Event::Kind::scroll}, {"key", Event::Kind::key},   {"set", Event::Kind::set},
+    {"screenshot", Event::Kind::screenshot}, {"quit", Event::Kind::quit},
+};
+
+const char* kind_name(Event::Kind k) {
+  for (const auto& [name, kind] : kKinds)
+    if (kind == k) return name;
+  return "?";
+}
+
+Event from_json(const nlohmann::json& j) {
+  if (!j.is_object()) throw std::invalid_argument("an event must be an object");
+  Event e;
+  const std::string kind = j.value("event", "");
+  bool known = false;
+  for (const auto& [name, k] : kKinds)
+    if (kind == name) e.kind = k, known = true;
+  if (!known) throw std::invalid_argument("unknown event '" + kind + "'");
+  for (const auto& [key, v] : j.items()) {
+    if (key == "event") continue;
+    if (key == "frame") e.frame = v.get<int>();
+    else if (key == "x") e.x = v.get<double>();
+    else if (key == "y") e.y = v.get<double>();
+    else if (key == "button") e.button = v.get<std::string>();
+    else if (key == "shift") e.shift = v.get<bool>();
+    else if (key == "key") e.key = v.get<std::string>();
+    else if (key == "file") e.file = v.get<std::string>();
+    else if (e.kind == Event::Kind::set && (key == "pipeline" || key == "integrator" || key == "dt" || key == "options"))
+      e.settings[key] = v.is_string() ? v.get<std::string>() : v.dump();
+    else
+      throw std::invalid_argument("unknown key '" + key + "'");
+  }
+  if (e.frame < 0) throw std::invalid_argument("frame must be >= 0");
+  if (e.kind == Event::Kind::press && e.button != "left" && e.button != "right" && e.button != "middle")
+    throw std::invalid_argument("button must be left, right or middle");
+  if (e.kind == Event::Kind::screenshot && e.file.empty()) throw std::invalid_argument("a screenshot needs a file");
+  return e;
+}
+
+}  // namespace
+
+nlohmann::json to_json(const Event& e) {
+  nlohmann::json j = {{"frame", e.frame}, {"event", kind_name(e.kind)}};
+  switch (e.kind) {
+    case Event::Kind::press:
+      j["button"] = e.button;
+      if (e.shift) j["shift"] = true;
+      [[fallthrough]];
+    case Event::Kind::move:
+    case Event::Kind::scroll:
+      j["x"] = e.x;
+      j["y"] = e.y;
+      break;
+    case Event::Kind::key: j["key"] = e.key; break;
+    case Event::Kind::set:
+      for (const auto& [k, v] : e.settings) j[k] = v;
+      break;
+    case Event::Kind::screenshot: j["file"] = e.file; break;
+    default: break;
+  }
+  return j;
+}
+
+std::vector<Event> read_script(const std::string& path) {
+  const nlohmann::json j = read_json_file(path, "script file");
+  if (!j.is_object() || !j.contains("events") || !j["events"].is_array() || j.size() != 1)
+    throw std::invalid_argument("script file " + path + ": expected {\"events\": [...]}");
+  std::vector<Event> out;
+  for (std::size_t k = 0; k < j["events"].size(); ++k) {
+    try {
+      out.push_back(from_json(j["events"][k]));
+    } catch (const std::exception& e) {  // nlohmann's type errors too
+      throw std::invalid_argument("script file " + path + ", event " + std::to_string(k) + ": " + e.what());
+    }
+    if (k > 0 && out[k].frame < out[k - 1].frame)
+      throw std::invalid_argument("script file " + path + ", event " + std::to_string(k) + ": frames must not decrease");
+  }
+  return out;
+}
+
+void write_script(const std::string& path, const std::vector<Event>& events) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Event& e : events) list.push_back(to_json(e));
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << nlohmann::json{{"events", list}}.dump(1) << "\n";
+    if (!out) throw std::runtime_error("cannot write " + path);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace deformlab::viewer
