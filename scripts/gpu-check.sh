@@ -26,7 +26,7 @@ part() { [[ " $parts " == *" $1 "* ]]; }
 if part tests; then
   ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
   summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
-  grep -E "Label|^ *(unit|match|gl|cuda|interop) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
+  grep -E "Label|^ *(unit|match|gl|cuda|interop|viewer) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
 fi
 
 cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
@@ -34,7 +34,7 @@ match_tests="$build/tests/match/deformlab_match_tests"
 if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
     {
-      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*volume8x6x5*'
+      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*'
       compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
