@@ -79,6 +79,29 @@ TEST_F(View, DraggedNodeFollowsTheCursorRay) {
   EXPECT_EQ(s["steps"], 80);
 }
 
+TEST_F(View, SavedSessionReplaysToTheSameState) {
+  const Model m = model();
+  const auto p = camera().pixel(m.rest_position[5 * 16 + 10], kW, kH);
+  nlohmann::json events = {{{"frame", 1}, {"event", "press"}, {"x", p[0]}, {"y", p[1]}, {"button", "left"}},
+                           {{"frame", 4}, {"event", "move"}, {"x", p[0] - 30}, {"y", p[1] - 40}},
+                           {{"frame", 9}, {"event", "release"}},
+                           {{"frame", 10}, {"event", "set"}, {"dt", "0.001"}},
+                           {{"frame", 11}, {"event", "key"}, {"key", "space"}},
+                           {{"frame", 13}, {"event", "key"}, {"key", "space"}}};
+  const fs::path script = write("live.json", nlohmann::json{{"events", events}}.dump());
+  const fs::path saved = dir_ / "saved.json", first = dir_ / "first.json", second = dir_ / "summary.json";
+  const std::string common = "--pipeline omp --steps-per-frame 3 --max-frames 16 ";
+  ASSERT_EQ(view(common + "--script " + script.string() + " --save-script " + saved.string() + " --summary " +
+                 first.string()).code, 0);
+  ASSERT_EQ(view(common + "--script " + saved.string() + " --summary " + second.string()).code, 0);
+  const nlohmann::json a = nlohmann::json::parse(slurp(first)), b = summary();
+  ASSERT_EQ(a["drags"].size(), 1u) << a.dump();
+  EXPECT_EQ(a["drags"], b["drags"]);
+  EXPECT_EQ(a["largest_move_m"], b["largest_move_m"]) << "the same steps from the same input";
+  EXPECT_EQ(b["dt"], 0.001f);
+  EXPECT_EQ(b["steps"], (16 - 2) * 3) << "two frames paused";
+}
+
 TEST_F(View, SwitchedPipelinesCarryTheStateOverExactly) {
   nlohmann::json events = {{{"frame", 3}, {"event", "set"}, {"pipeline", "omp"}},
                            {{"frame", 6}, {"event", "set"}, {"pipeline", "glsl-compute"}, {"integrator", "verlet"}},
