@@ -61,21 +61,26 @@ bool text_field(const char* label, std::string& text) {
   return enter;
 }
 
+// The step's stages and the frame's draw, each against the longest, on its own clock.
 void stage_bars(const Stats& s) {
-  double longest = s.step_ms;
+  double longest = std::max(s.step_ms, s.draw_ms);
   for (const auto& st : s.stages) longest = std::max(longest, st.median_ms);
-  for (const auto& st : s.stages) {
-    if (st.name == "step") continue;
+  auto bar = [&](const std::string& name, double ms, const std::string& what) {
     char label[160];
-    std::snprintf(label, sizeof label, "%s %.4f ms", st.name.c_str(), st.median_ms);
-    ImGui::ProgressBar(longest > 0 ? float(st.median_ms / longest) : 0.f, ImVec2(-1, 0), label);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("median per step over %d steps, %s", st.steps, st.clock.c_str());
-  }
+    std::snprintf(label, sizeof label, "%s %.4f ms", name.c_str(), ms);
+    ImGui::ProgressBar(longest > 0 ? float(ms / longest) : 0.f, ImVec2(-1, 0), label);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", what.c_str());
+  };
+  for (const auto& st : s.stages)
+    if (st.name != "step")
+      bar(st.name, st.median_ms, "median per step over " + std::to_string(st.steps) + " steps, " + st.clock);
+  bar("render", s.draw_ms, "median per frame, " + s.draw_clock);
 }
 
 }  // namespace
 
-PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const std::string& message, bool paused) {
+PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const std::string& message, bool paused,
+                        bool recording) {
   PanelActions a;
   const ImGuiIO& io = ImGui::GetIO();
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - kPanelWidth, 0));
@@ -109,12 +114,9 @@ PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const s
   if (ImGui::Checkbox("wireframe", &wire)) a.events.push_back(key("w"));
   ImGui::SameLine();
   if (ImGui::Checkbox("points", &points)) a.events.push_back(key("m"));
-  if (ImGui::Button("screenshot")) {
-    Event e;
-    e.kind = Event::Kind::screenshot;
-    e.file = "deformlab-view-" + std::to_string(session.steps()) + ".png";
-    a.events.push_back(e);
-  }
+  if (ImGui::Button("screenshot")) a.events.push_back(key("p"));
+  ImGui::SameLine();
+  if (ImGui::Button(recording ? "stop recording" : "record")) a.events.push_back(key("v"));
 
   ImGui::Separator();
   ImGui::Text("t = %.4f s, step %d", session.time(), session.steps());
@@ -136,7 +138,8 @@ PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const s
   ImGui::TextDisabled("shift-click a node: pin or free it");
   ImGui::TextDisabled("left-drag: orbit, right-drag: pan, wheel: zoom");
   ImGui::TextDisabled("keys: space pause, n step, backspace reset,");
-  ImGui::TextDisabled("r camera, w wireframe, m points");
+  ImGui::TextDisabled("r camera, w wireframe, m points,");
+  ImGui::TextDisabled("p screenshot, v record / stop");
   ImGui::End();
   return a;
 }

@@ -38,6 +38,7 @@ struct PanelActions {
   bool profile_changed = false;
 };
 
-PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const std::string& message, bool paused);
+PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const std::string& message, bool paused,
+                        bool recording);
 
 }  // namespace deformlab::viewer

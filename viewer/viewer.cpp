@@ -38,6 +38,7 @@ class Viewer {
       : w_(w), s_(s), o_(o), r_(s.model(), {.width = view_width(), .height = std::max(w.height(), 1), .ground = o.ground}),
         home_(r_.camera()), start_(s.pipeline().state()), script_(o.script) {
     if (!o_.record.empty()) rec_ = std::make_unique<Recorder>(o_.record, w_.width(), w_.height(), kVideoFps);
+    summary_["recordings"] = nlohmann::json::array();
     panel_.steps_per_frame = o_.steps_per_frame;
     watch();
     draw_state();  // picking reads the depth of the frame last drawn
@@ -54,16 +55,14 @@ class Viewer {
       simulate();
       draw();
       for (const std::string& file : std::exchange(shots_, {})) screenshot(file);
+      if (rec_ && (rec_->width() != w_.width() || rec_->height() != w_.height())) stop_recording();
       if (rec_) rec_->add(window_pixels());
       w_.swap();
       ++frame_;
       if ((o_.frames > 0 && frame_ >= o_.frames) || (video_frames > 0 && frame_ >= video_frames)) quit_ = true;
     }
     try {
-      if (rec_) {
-        rec_->finish();
-        summary_["recording"] = {{"file", rec_->file()}, {"frames", rec_->frames()}, {"fps", kVideoFps}};
-      }
+      if (rec_) finish_recording();
       if (!o_.save_script.empty()) write_script(o_.save_script, recorded_);
     } catch (const std::exception& e) {
       std::cerr << "deformlab: error: " << e.what() << "\n";
@@ -163,8 +162,36 @@ class Viewer {
     mouse_ = Mouse::none;
   }
 
+  void finish_recording() {
+    const std::unique_ptr<Recorder> r = std::move(rec_);
+    r->finish();
+    summary_["recordings"].push_back({{"file", r->file()}, {"frames", r->frames()}, {"fps", kVideoFps}});
+    message_ = "recorded " + r->file() + " (" + std::to_string(r->frames()) + " frames)";
+  }
+
+  // Key v: a recording into deformlab-view-<frame>.mp4 starts, or the one running ends.
+  void stop_recording() {
+    try {
+      finish_recording();
+    } catch (const std::exception& e) {
+      message_ = e.what();
+    }
+  }
+  void toggle_recording() {
+    if (rec_) return stop_recording();
+    try {
+      rec_ = std::make_unique<Recorder>("deformlab-view-" + std::to_string(frame_) + ".mp4", w_.width(), w_.height(),
+                                        kVideoFps);
+      message_ = "recording " + rec_->file();
+    } catch (const std::exception& e) {
+      message_ = e.what();
+    }
+  }
+
   void key(const std::string& k) {
     if (k == "space") paused_ = !paused_;
+    else if (k == "p") shots_.push_back("deformlab-view-" + std::to_string(frame_) + ".png");
+    else if (k == "v") toggle_recording();
     else if (k == "n") single_ = true;
     else if (k == "r") r_.set_camera(home_);
     else if (k == "backspace") reset();
@@ -284,7 +311,7 @@ class Viewer {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     refresh_stats();
     w_.begin_panel();
-    const PanelActions a = show_panel(panel_, stats_, s_, message_, paused_);
+    const PanelActions a = show_panel(panel_, stats_, s_, message_, paused_, bool(rec_));
     w_.end_panel();
     gl::check("drawing the viewer's frame");
     // The panel's changes are applied with the next frame's input, and recorded as such.

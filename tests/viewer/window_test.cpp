@@ -165,6 +165,26 @@ TEST_F(View, RecordsAPlayableMp4OfTheFramesAsked) {
     EXPECT_EQ(f.path().filename().string().find(".partial"), std::string::npos) << "left behind: " << f.path();
 }
 
+TEST_F(View, KeysTakeScreenshotsAndRecordingsIntoTheWorkingFolder) {
+  if (!have("ffprobe")) GTEST_SKIP() << "ffmpeg is not installed";
+  const nlohmann::json events = {{{"frame", 1}, {"event", "key"}, {"key", "p"}},
+                                 {{"frame", 2}, {"event", "key"}, {"key", "v"}},
+                                 {{"frame", 12}, {"event", "key"}, {"key", "v"}}};
+  const fs::path script = write("keys.json", nlohmann::json{{"events", events}}.dump());
+  const Result r = run_wrapped("cd " + dir_.string() + " && xvfb-run -a -s '-screen 0 1600x1000x24' ",
+                               "view --scene " + scene_.string() + " --pipeline cpu --max-frames 15 --script " +
+                                   script.string() + " --summary " + (dir_ / "summary.json").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "deformlab-view-1.png"));
+  const nlohmann::json s = summary();
+  ASSERT_EQ(s["recordings"].size(), 1u) << s.dump();
+  EXPECT_EQ(s["recordings"][0]["frames"], 10) << "frames 2 to 11";
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
+                          "-of csv=p=0 " + (dir_ / "deformlab-view-2.mp4").string() + " > " + (dir_ / "probe.txt").string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(slurp(dir_ / "probe.txt"), "10\n");
+}
+
 TEST_F(View, RefusesBadInputWithOneLine) {
   const fs::path bad = write("bad.json", R"({"events": [{"frame": 1, "event": "teleport"}]})");
   for (const auto& [args, needle] : std::vector<std::pair<std::string, std::string>>{
