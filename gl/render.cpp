@@ -101,6 +101,12 @@ struct Renderer::Impl {
   int stride = 1;  // surface: every stride-th row and column (a frame shows no more)
   Camera camera;
   bool wireframe = false;
+  Colour colour = Colour::plain;
+  float scale = 1.f;
+  Buffer rest, prev;  // colour by strain: rest positions; by speed: the positions last drawn
+  Texture rest_tex, prev_tex, tri_tex;
+  double time = 0.0, prev_time = 0.0;
+  bool have_prev = false;
   GLint texels = 0, align = 16;
   Timer timer;
 
@@ -213,13 +219,21 @@ struct Renderer::Impl {
                 std::clamp(float(o.width) / std::sqrt(float(m.node_count())) * 0.4f, 1.f, 8.f));
     glUniform3f(uniform(prog.id(), "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
     glUniform1i(uniform(prog.id(), "u_stride"), stride);
+    glUniform1i(uniform(prog.id(), "u_colour"), int(colour));
+    glUniform1f(uniform(prog.id(), "u_scale"), scale);
+    glUniform1f(uniform(prog.id(), "u_frame_dt"), have_prev ? float(time - prev_time) : 0.f);
     if (!draw_tex) draw_tex = make_texture();
+    if (colour != Colour::plain) bind_colour_data();
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_BUFFER, draw_tex.id());
     glBindVertexArray(vao.id());
     const int quads_per_row = (m.nx - 2) / stride + 1;
     for (const Band& b : bands) {
       glTexBufferRange(GL_TEXTURE_BUFFER, GL_RGBA32F, positions, GLintptr(b.tex_first * 16), GLsizeiptr(b.tex_count * 16));
+      if (colour != Colour::plain) {
+        glTextureBufferRange(rest_tex.id(), GL_RGBA32F, rest.id(), GLintptr(b.tex_first * 16), GLsizeiptr(b.tex_count * 16));
+        glTextureBufferRange(prev_tex.id(), GL_RGBA32F, prev.id(), GLintptr(b.tex_first * 16), GLsizeiptr(b.tex_count * 16));
+      }
       glUniform1i(uniform(prog.id(), "u_first"), b.first);
       glUniform1i(uniform(prog.id(), "u_tex_first"), int(b.tex_first));
       if (mesh) {
@@ -235,9 +249,35 @@ struct Renderer::Impl {
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
     glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    if (colour == Colour::speed) {  // these positions are the next draw's previous ones
+      glCopyNamedBufferSubData(positions, prev.id(), 0, 0, GLsizeiptr(m.node_count()) * 16);
+      prev_time = time;
+      have_prev = true;
+    }
     timer.end();
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     check("rendering a frame");
+  }
+
+  // The rest positions, the previous positions and a mesh's triangles as texture buffers on
+  // units 1 to 3 (made on first use).
+  void bind_colour_data() {
+    const std::size_t n = std::size_t(m.node_count());
+    if (!rest) {
+      std::vector<float> r(4 * n);
+      for (std::size_t i = 0; i < n; ++i) std::copy_n(&m.rest_position[i].x, 3, &r[4 * i]);
+      rest = make_buffer(r.size() * 4, r.data());
+      prev = make_buffer(n * 16);
+      for (Texture* t : {&rest_tex, &prev_tex, &tri_tex}) {
+        GLuint id = 0;
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
+        *t = Texture(id);
+      }
+      if (elements) glTextureBuffer(tri_tex.id(), GL_R32I, elements.id());
+    }
+    glBindTextureUnit(1, rest_tex.id());
+    glBindTextureUnit(2, prev_tex.id());
+    glBindTextureUnit(3, tri_tex.id());
   }
 
   static Texture make_texture() {
@@ -319,6 +359,14 @@ int Renderer::height() const { return impl_->o.height; }
 const Camera& Renderer::camera() const { return impl_->camera; }
 void Renderer::set_camera(const Camera& c) { impl_->camera = c; }
 void Renderer::set_wireframe(bool on) { impl_->wireframe = on; }
+void Renderer::set_time(double t) { impl_->time = t; }
+
+void Renderer::set_colour(Colour c, float scale) {
+  if (!(scale > 0.f)) throw std::invalid_argument("a colour scale must be positive");
+  if (c == Colour::speed && impl_->colour != Colour::speed) impl_->have_prev = false;
+  impl_->colour = c;
+  impl_->scale = scale;
+}
 unsigned Renderer::framebuffer() const { return impl_->fbo.id(); }
 
 std::optional<Vec3f> Renderer::surface_at(double px, double py) {

@@ -76,6 +76,13 @@ class Renderer {
   void set_camera(const Camera& c);
   void set_mode(RenderOptions::Mode m);  // throws std::invalid_argument where the model has no surface
   void set_wireframe(bool on);           // surfaces as their edges
+  // Colour by speed (each node's displacement since the previous draw over the simulated time
+  // between them, set_time) or by strain (a cloth node's larger relative change of its spans
+  // along the grid's two directions, a mesh triangle's largest of its edges), from blue at 0
+  // to red at `scale` (m/s, or a fraction) and above.
+  enum class Colour { plain, speed, strain };
+  void set_colour(Colour c, float scale);
+  void set_time(double t);  // the simulated time of the state drawn next
   void resize(int width, int height);
   unsigned framebuffer() const;          // the GL framebuffer drawn into (colour attachment 0)
   // The point of the model drawn under pixel (px, py) (from the top left) in the last frame,

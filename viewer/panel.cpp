@@ -114,6 +114,13 @@ PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const s
   if (ImGui::Checkbox("wireframe", &wire)) a.events.push_back(key("w"));
   ImGui::SameLine();
   if (ImGui::Checkbox("points", &points)) a.events.push_back(key("m"));
+  ImGui::Combo("colour", &p.colour, "plain\0speed (m/s)\0strain\0");
+  if (p.colour != 0) {
+    ImGui::InputFloat("red at", &p.scale[p.colour], 0.f, 0.f, "%.3g");
+    p.scale[p.colour] = std::max(p.scale[p.colour], 1e-6f);
+    ImGui::TextDisabled(p.colour == 1 ? "displacement since the last frame over its time"
+                                      : "cloth: spans along the grid; mesh: triangle edges");
+  }
   if (ImGui::Button("screenshot")) a.events.push_back(key("p"));
   ImGui::SameLine();
   if (ImGui::Button(recording ? "stop recording" : "record")) a.events.push_back(key("v"));
@@ -138,7 +145,7 @@ PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const s
   ImGui::TextDisabled("shift-click a node: pin or free it");
   ImGui::TextDisabled("left-drag: orbit, right-drag: pan, wheel: zoom");
   ImGui::TextDisabled("keys: space pause, n step, backspace reset,");
-  ImGui::TextDisabled("r camera, w wireframe, m points,");
+  ImGui::TextDisabled("r camera, w wireframe, m points, c colour,");
   ImGui::TextDisabled("p screenshot, v record / stop");
   ImGui::End();
   return a;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/profiler.hpp"
+#include "gl/render.hpp"
 #include "script.hpp"
 #include "session.hpp"
 
@@ -18,6 +19,8 @@ struct PanelState {
   int steps_per_frame = 10;
   bool profile = true;  // stage spans (CUDA pipelines then run pass by pass, without graphs)
   bool wireframe = false, points = false;
+  int colour = 0;                     // gl::Renderer::Colour: plain, speed, strain
+  float scale[3] = {1.f, 1.f, 0.1f};  // red at: -, m/s, strain
   std::string option_text, dt_text;
 };
 

@@ -190,6 +190,7 @@ class Viewer {
 
   void key(const std::string& k) {
     if (k == "space") paused_ = !paused_;
+    else if (k == "c") panel_.colour = (panel_.colour + 1) % 3;
     else if (k == "p") shots_.push_back("deformlab-view-" + std::to_string(frame_) + ".png");
     else if (k == "v") toggle_recording();
     else if (k == "n") single_ = true;
@@ -276,6 +277,8 @@ class Viewer {
   // copied on the device through interop, else a read-back.
   void draw_state() {
     Pipeline& p = s_.pipeline();
+    r_.set_colour(gl::Renderer::Colour(panel_.colour), panel_.scale[panel_.colour]);
+    r_.set_time(s_.time());
     if (const unsigned b = p.gl_position_buffer()) {
       r_.draw_positions(b);
       drawn_from_ = "the pipeline's own GL buffer (no copy)";

@@ -113,6 +113,47 @@ TEST(GlRender, MeshTrianglesInAnyNodeOrder) {
   EXPECT_EQ(coverage(again.pixels(), 200, 200).pixels, f.pixels) << "drawn from the pipeline's own buffer";
 }
 
+// The colour under `x`: red minus blue (positive: the hot end of the ramp).
+int warmth(gl::Renderer& r, Vec3f x) {
+  const auto px = r.pixels();
+  const auto p = r.camera().pixel(x, r.width(), r.height());
+  const std::uint8_t* q = &px[(std::size_t(p[1]) * r.width() + std::size_t(p[0])) * 4];
+  return int(q[0]) - int(q[2]);
+}
+
+// Strain: at rest blue, stretched by 30% (over a scale of 20%) red, on a cloth grid (by node)
+// and on a mesh (by triangle). Speed: nodes moved 0.2 m in 0.1 s (over 1 m/s) red, then still.
+TEST(GlRender, ColoursByStrainAndSpeed) {
+  DEFORMLAB_REQUIRE_GL();
+  Mesh sheet = triangulated_square(30, 30);
+  repair(sheet);
+  for (const Model& m : {small_cloth(30, 30), mesh_model(sheet, Material{}, 0.f)}) {
+    const int centre = 30 * 15 + 15;
+    const Vec3f c = m.rest_position[centre];
+    State stretched = rest_state(m);
+    for (Vec3f& x : stretched.x) x = c + (x - c) * 1.3f;
+    gl::Renderer r(m, {300, 300});
+    r.set_colour(gl::Renderer::Colour::strain, 0.2f);
+    r.draw(rest_state(m));
+    EXPECT_LT(warmth(r, c), -50) << "at rest: no strain";
+    r.draw(stretched);
+    EXPECT_GT(warmth(r, c), 50) << "stretched by 30%";
+
+    State moved = rest_state(m);
+    for (Vec3f& x : moved.x) x.y += 0.2f;
+    r.set_colour(gl::Renderer::Colour::speed, 1.f);
+    r.set_time(0.0);
+    r.draw(rest_state(m));
+    EXPECT_LT(warmth(r, c), -50) << "nothing drawn before: no speed";
+    r.set_time(0.1);
+    r.draw(moved);
+    EXPECT_GT(warmth(r, c + Vec3f{0.f, 0.2f, 0.f}), 50) << "2 m/s";
+    r.set_time(0.2);
+    r.draw(moved);
+    EXPECT_LT(warmth(r, c + Vec3f{0.f, 0.2f, 0.f}), -50) << "still";
+  }
+}
+
 TEST(GlRender, LatticeAsPointsAndPngFile) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_lattice(6, 5, 4);
