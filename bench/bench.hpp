@@ -73,6 +73,7 @@ void add_gl_bench(CLI::App& app);
 #endif
 #if DEFORMLAB_HAVE_INTEROP
 void add_hybrid_bench(CLI::App& app);
+void add_draw_bench(CLI::App& app);
 #endif
 
 }  // namespace deformlab::bench

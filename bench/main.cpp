@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
 #endif
 #if DEFORMLAB_HAVE_INTEROP
   deformlab::bench::add_hybrid_bench(cli);
+  deformlab::bench::add_draw_bench(cli);
 #endif
   try {
     cli.parse(argc, argv);

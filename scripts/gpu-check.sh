@@ -51,6 +51,7 @@ if part bench; then
   bench_pair cuda cuda --sizes 256 1024 2048 4096
   bench_pair gl gl --sizes 256 1024 2048
   bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
+  bench_pair draw draw --sizes 256 1024 2048 4096
 fi
 
 if part experiments; then
