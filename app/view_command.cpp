@@ -11,7 +11,7 @@
 namespace deformlab::app {
 
 int view_command(const ViewArgs& a) {
-  return report_errors([&] {
+  return report_errors([&]() -> int {
     if (a.steps_per_frame < 1) throw std::invalid_argument("--steps-per-frame must be at least 1");
     if (a.seconds && !a.record) throw std::invalid_argument("--seconds needs --record");
     if (a.seconds && !(*a.seconds > 0 && *a.seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");

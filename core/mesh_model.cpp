@@ -69,6 +69,27 @@ void check_elements(const Mesh& m, const std::vector<std::array<std::int32_t, N>
   }
 }
 
+// Keeps the first of elements with the same vertices (in any order or orientation); returns
+// how many it dropped.
+template <std::size_t N>
+std::int64_t drop_duplicates(std::vector<std::array<std::int32_t, N>>& elements) {
+  std::vector<std::pair<std::array<std::int32_t, N>, std::int64_t>> keyed(elements.size());
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    keyed[e] = {elements[e], std::int64_t(e)};
+    std::sort(keyed[e].first.begin(), keyed[e].first.end());
+  }
+  sort_all(keyed);
+  std::vector<char> drop(elements.size(), 0);
+  std::int64_t dropped = 0;
+  for (std::size_t k = 1; k < keyed.size(); ++k)
+    if (keyed[k].first == keyed[k - 1].first) drop[std::size_t(keyed[k].second)] = 1, ++dropped;
+  std::size_t kept = 0;
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (!drop[e]) elements[kept++] = elements[e];
+  elements.resize(kept);
+  return dropped;
+}
+
 }  // namespace
 
 std::vector<std::string> repair(Mesh& m) {
@@ -117,9 +138,13 @@ std::vector<std::string> repair(Mesh& m) {
 
   check_elements(m, m.triangle, "triangle", triangle_area, welded > 0);
   check_elements(m, m.tetrahedron, "tetrahedron", tetrahedron_volume, welded > 0);
+  // A repeated element would add a self-spring across its own sides.
+  const std::int64_t repeated = drop_duplicates(m.triangle) + drop_duplicates(m.tetrahedron);
   std::vector<std::string> lines;
   if (welded) lines.push_back("welded " + std::to_string(welded) + " duplicate vertices");
   if (unreferenced) lines.push_back("dropped " + std::to_string(unreferenced) + " unreferenced vertices");
+  if (repeated)
+    lines.push_back("dropped " + std::to_string(repeated) + " repeated " + (m.volume() ? "tetrahedra" : "triangles"));
   return lines;
 }
 

@@ -29,7 +29,8 @@ struct Mesh {
 
 // Checks a mesh as loaded and repairs what can be repaired, returning a line per repair:
 // vertices at identical positions are welded, vertices no element uses are dropped (the
-// others keep their order). Throws std::invalid_argument naming the first problem: no
+// others keep their order), elements repeated on the same vertices (after welding, in any
+// order) are dropped but the first. Throws std::invalid_argument naming the first problem: no
 // elements, an index out of range, a NaN or infinite coordinate, a degenerate element
 // (repeated vertex, zero area or volume), an edge shared by more than two triangles or a
 // face shared by more than two tetrahedra.

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 findings=build/fuzz/findings
 mkdir -p "$findings"
-for target in scene experiment; do
+for target in scene experiment mesh; do
   work=$(mktemp -d)
   cp tests/fuzz/corpus/$target/* "$work/"
   echo "fuzz: $target for ${seconds} s from $(ls "$work" | wc -l) seeds"

@@ -1,7 +1,6 @@
 #include "viewer.hpp"
 
 #include <GL/glew.h>
-#include <imgui.h>
 
 #include <algorithm>
 #include <chrono>

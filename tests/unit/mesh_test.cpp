@@ -166,6 +166,25 @@ TEST(MeshModel, RepairsWeldDuplicatesAndDropUnreferencedVertices) {
   EXPECT_EQ(mesh_model(m, Material{}, 0.f).spring_count(), model_of(triangulated_square(3, 3)).spring_count());
 }
 
+TEST(MeshModel, RepeatedElementsAreDroppedNotMadeIntoSelfSprings) {
+  // Found by the mesh fuzzer: a triangle repeated on a welded copy of a vertex gave a spring
+  // from a node to itself across the shared edge.
+  Mesh m = triangulated_square(3, 3);
+  m.triangle.push_back({m.triangle[2][2], m.triangle[2][0], m.triangle[2][1]});  // triangle 2 again, rotated
+  m.position.push_back(m.position[0]);
+  m.triangle.push_back({9, m.triangle[0][1], m.triangle[0][2]});  // triangle 0 on a copy of vertex 0
+  Mesh box = tetrahedralised_box(2, 2, 2);
+  box.tetrahedron.push_back({box.tetrahedron[3][1], box.tetrahedron[3][0], box.tetrahedron[3][2], box.tetrahedron[3][3]});
+  EXPECT_EQ(repair(m), (std::vector<std::string>{"welded 1 duplicate vertices", "dropped 2 repeated triangles"}));
+  EXPECT_EQ(repair(box), std::vector<std::string>{"dropped 1 repeated tetrahedra"});
+  EXPECT_EQ(mesh_model(m, Material{}, 0.f).spring_count(), model_of(triangulated_square(3, 3)).spring_count());
+  const Model b = mesh_model(box, Material{}, 0.f);
+  Mesh plain_box = tetrahedralised_box(2, 2, 2);
+  repair(plain_box);
+  EXPECT_EQ(b.spring_count(), mesh_model(plain_box, Material{}, 0.f).spring_count());
+  for (std::size_t s = 0; s < b.spring_i.size(); ++s) EXPECT_LT(b.spring_i[s], b.spring_j[s]);
+}
+
 TEST(MeshModel, MalformedMeshesAreRefusedByName) {
   Mesh empty;
   EXPECT_EQ(error_of(empty), "the mesh has no triangles or tetrahedra");
