@@ -27,9 +27,10 @@ Mat4 mul(const Mat4& a, const Mat4& b) {
 
 Vec3f normalized(Vec3f v) { return v * (1.f / norm(v)); }
 
-Mat4 look_at(Vec3f eye, Vec3f at, Vec3f up) {
-  const Vec3f f = normalized(at - eye), s = normalized(cross(f, up)), u = cross(s, f);
-  return {s.x, u.x, -f.x, 0, s.y, u.y, -f.y, 0, s.z, u.z, -f.z, 0, -dot(s, eye), -dot(u, eye), dot(f, eye), 1};
+Mat4 view_matrix(const Camera& c) {
+  const auto [f, s, u] = c.axes();
+  const Vec3f e = c.eye;
+  return {s.x, u.x, -f.x, 0, s.y, u.y, -f.y, 0, s.z, u.z, -f.z, 0, -dot(s, e), -dot(u, e), dot(f, e), 1};
 }
 
 Mat4 perspective(float fovy, float aspect, float znear, float zfar) {
@@ -47,15 +48,20 @@ GLint bound_framebuffer(GLenum which = GL_DRAW_FRAMEBUFFER_BINDING) {
 
 }  // namespace
 
+Camera::Axes Camera::axes() const {
+  const Vec3f f = normalized(target - eye), s = normalized(cross(f, up));
+  return {f, s, cross(s, f)};
+}
+
 std::pair<Vec3f, Vec3f> Camera::ray(double px, double py, int w, int h) const {
-  const Vec3f f = normalized(target - eye), s = normalized(cross(f, up)), u = cross(s, f);
+  const auto [f, s, u] = axes();
   const float t = std::tan(fovy / 2), aspect = float(w) / float(h);
   const float nx = float(2 * px / w - 1), ny = float(1 - 2 * py / h);
   return {eye, normalized(f + s * (nx * t * aspect) + u * (ny * t))};
 }
 
 std::array<double, 2> Camera::pixel(Vec3f x, int w, int h) const {
-  const Vec3f f = normalized(target - eye), s = normalized(cross(f, up)), u = cross(s, f);
+  const auto [f, s, u] = axes();
   const Vec3f d = x - eye;
   const double t = std::tan(fovy / 2), aspect = double(w) / h, depth = dot(d, f);
   if (!(depth > 0)) return {std::nan(""), std::nan("")};  // behind the eye
@@ -172,7 +178,7 @@ struct Renderer::Impl {
   Mat4 view_proj() const {
     const float dist = norm(camera.eye - camera.target);
     return mul(perspective(camera.fovy, float(o.width) / float(o.height), dist * 0.05f, dist * 4.f),
-               look_at(camera.eye, camera.target, camera.up));
+               view_matrix(camera));
   }
 
   // Splits the drawing into bands whose positions fit in one texture buffer view of at most
@@ -386,7 +392,7 @@ std::optional<Vec3f> Renderer::surface_at(double px, double py) {
   const float dist = norm(c.eye - c.target), n = dist * 0.05f, f = dist * 4.f;
   const float z_ndc = 2.f * depth - 1.f, z = 2.f * f * n / ((f + n) - z_ndc * (f - n));
   const auto [o, d] = c.ray(px, py, r.o.width, r.o.height);
-  return o + d * (z / dot(d, normalized(c.target - c.eye)));
+  return o + d * (z / dot(d, c.axes().forward));
 }
 
 void Renderer::set_mode(RenderOptions::Mode m) {

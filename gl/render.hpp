@@ -37,6 +37,11 @@ struct Camera {
   Vec3f eye, target, up{0.f, 1.f, 0.f};
   float fovy = 0.8f;
 
+  // Unit axes: where it looks, its right and its up (those of the view matrix).
+  struct Axes {
+    Vec3f forward, right, up;
+  };
+  Axes axes() const;
   // The ray through pixel (px, py) (from the top left; pixel centres at .5) of a w x h view:
   // the eye and a unit direction.
   std::pair<Vec3f, Vec3f> ray(double px, double py, int w, int h) const;

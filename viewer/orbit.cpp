@@ -28,7 +28,7 @@ void orbit(gl::Camera& c, float yaw, float pitch) {
 }
 
 void pan(gl::Camera& c, float dx, float dy, int h) {
-  const Vec3f f = unit(c.target - c.eye), s = unit(cross(f, c.up)), u = cross(s, f);
+  const auto [f, s, u] = c.axes();
   const float per_px = 2.f * norm(c.target - c.eye) * std::tan(c.fovy / 2) / float(h);
   const Vec3f move = s * (-dx * per_px) + u * (dy * per_px);
   c.eye = c.eye + move;

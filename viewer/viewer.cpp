@@ -124,8 +124,7 @@ class Viewer {
     }
     mouse_ = Mouse::drag_node;
     plane_point_ = st.x[node];
-    const Vec3f f = c.target - c.eye;
-    plane_normal_ = f * (1.f / norm(f));
+    plane_normal_ = c.axes().forward;
     s_.drag(node, plane_point_);
     target_ = plane_point_;
   }
