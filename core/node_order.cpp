@@ -77,12 +77,14 @@ std::vector<std::int32_t> morton(const Model& m) {
   Vec3f lo = m.rest_position[0], hi = lo;
   for (const auto& p : m.rest_position)
     for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], p[c]); hi[c] = std::max(hi[c], p[c]); }
+  // One scale for the three axes (the bounding cube): scaled per axis, a thin axis (a sheet's
+  // slight relief) would take as many bits as the wide ones and scramble the curve.
+  const double span = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   std::vector<std::pair<std::uint64_t, std::int32_t>> keys(n);
 #pragma omp parallel for
   for (int v = 0; v < n; ++v) {
     std::uint64_t code = 0;
     for (int c = 0; c < 3; ++c) {
-      const float span = hi[c] - lo[c];
       const double u = span > 0 ? double(m.rest_position[v][c] - lo[c]) / span : 0.0;
       code |= spread(std::uint64_t(std::min(u, 1.0) * 2097151.0)) << c;
     }
