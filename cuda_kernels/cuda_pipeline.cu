@@ -21,6 +21,7 @@
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
 #include "force_pass.hpp"
+#include "core/partition.hpp"
 #include "core/stage.hpp"
 #include "core/step_params.hpp"
 #include "kernels.cuh"
@@ -61,14 +62,11 @@ class ForceKernels {
     if (m.grid()) {
       const auto entries = stencil_entries<float>(m);
       std::copy(entries.begin(), entries.end(), stencil_.e);
+    } else if (o_.variant == Variant::tiled) {
+      upload_tiling();
     } else if (o_.variant != Variant::scatter) {
-      std::vector<Link> links(m.adj_node.size());  // general models only
-      for (std::size_t e = 0; e < links.size(); ++e) {
-        const int sp = m.adj_spring[e];
-        links[e] = {m.adj_node[e], m.rest_length[sp], m.spring_k(sp), m.spring_kd(sp)};
-      }
       upload(offset_, m.adj_offset, "uploading the adjacency offsets");
-      upload(links_, links, "uploading the adjacency");
+      upload(links_, links_of(m.adj_node, m.adj_spring), "uploading the adjacency");
     }
     if (o_.variant == Variant::scatter && !m.grid()) upload_springs();
   }
@@ -92,6 +90,13 @@ class ForceKernels {
       check_launch("launching the scatter finishing kernel");
       return;
     }
+    if (!model_.grid() && o_.variant == Variant::tiled) {
+      const dev::TiledCsr t{tile_offset_.get(), tile_node_.get(), members_.get(), offset_.get(), links_.get()};
+      if (damped_) dev::force_tiled_csr<true><<<tiles_, tile_threads_, tile_shared_, stream>>>(sp_, t, x, v, acc, target);
+      else dev::force_tiled_csr<false><<<tiles_, tile_threads_, tile_shared_, stream>>>(sp_, t, x, v, acc, target);
+      check_launch("launching the tiled mesh force kernel");
+      return;
+    }
     if (!model_.grid()) {
       dev::force_csr<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, offset_.get(), links_.get(), x, v, acc,
                                                                         target);
@@ -111,6 +116,38 @@ class ForceKernels {
   void upload(Buffer<T>& b, const std::vector<T>& h, const char* what) {
     b.allocate(h.size(), what);
     if (!h.empty()) check(cudaMemcpy(b.get(), h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice), what);
+  }
+  // One link per CSR entry: `node` (another node, or a cell of a tile) and spring's constants.
+  std::vector<Link> links_of(const std::vector<std::int32_t>& node, const std::vector<std::int32_t>& spring) const {
+    std::vector<Link> links(node.size());
+    for (std::size_t e = 0; e < links.size(); ++e)
+      links[e] = {node[e], model_.rest_length[spring[e]], model_.spring_k(spring[e]), model_.spring_kd(spring[e])};
+    return links;
+  }
+  // cuda-tiled on a general model: one thread block per tile of tile.x * tile.y nodes
+  // (core/partition.hpp), the tile's positions (and velocities) in shared memory.
+  void upload_tiling() {
+    const Tiling t = tile_model(model_, o_.tile.x * o_.tile.y);
+    const std::vector<Link> links = links_of(t.link_cell, t.link_spring);
+    damped_ = std::any_of(links.begin(), links.end(), [](const Link& l) { return l.kd != 0.f; });
+    tiles_ = unsigned(t.blocks());
+    tile_threads_ = unsigned(o_.tile.x * o_.tile.y);
+    tile_shared_ = std::size_t(t.largest_tile()) * sizeof(float4) * (damped_ ? 2 : 1);
+    int device = 0, limit = 0;
+    check(cudaGetDevice(&device), "finding the device");
+    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device), "reading the shared-memory limit");
+    if (tile_shared_ > std::size_t(limit))
+      throw std::invalid_argument("cuda-tiled: the largest tile of " + std::to_string(t.largest_tile()) + " nodes needs " +
+                                  std::to_string(tile_shared_) + " bytes of shared memory; this device allows " +
+                                  std::to_string(limit) + " (choose a smaller tile)");
+    for (const auto kernel : {dev::force_tiled_csr<true>, dev::force_tiled_csr<false>})
+      check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(tile_shared_)),
+            "raising the tiled kernel's shared-memory limit");
+    upload(tile_offset_, t.tile_offset, "uploading the tiles");
+    upload(tile_node_, t.tile_node, "uploading the tiles' nodes");
+    upload(members_, t.members, "uploading the tiles' member counts");
+    upload(offset_, t.link_offset, "uploading the tiles' adjacency offsets");
+    upload(links_, links, "uploading the tiles' adjacency");
   }
   void upload_springs() {
     const Model& m = model_;  // general models (grids have no spring list)
@@ -160,8 +197,11 @@ class ForceKernels {
   bool damped_ = false;
   dev::StepParams sp_;
   Stencil stencil_{};
-  Buffer<int> offset_;
+  Buffer<int> offset_;  // CSR offsets: per node, or per tile cell (cuda-tiled)
   Buffer<Link> links_;
+  Buffer<int> tile_offset_, tile_node_, members_;  // cuda-tiled on general models
+  unsigned tiles_ = 0, tile_threads_ = 0;
+  std::size_t tile_shared_ = 0;
   Buffer<Spring> springs_;
 };
 

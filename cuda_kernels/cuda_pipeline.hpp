@@ -15,7 +15,8 @@ namespace deformlab::cuda {
 
 enum class Variant {
   naive,    // one thread per node gathering its springs from global memory
-  tiled,    // the same gather from a shared-memory tile of the grid with a 2-node halo
+  tiled,    // the same gather from a shared-memory tile: a grid block with a 2-node halo, or a
+            // mesh tile of core/partition.hpp (tile.x * tile.y nodes along the Z-order, and its halo)
   scatter,  // one thread per spring, +f / -f added with atomics (not bitwise deterministic)
   fused,    // gather + update + constraints in one kernel for one-force-pass integrators
 };

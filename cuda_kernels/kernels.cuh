@@ -261,6 +261,47 @@ __global__ void fused_csr(StepParams s, float weight, const int* __restrict__ of
   store_displacement(check, d);
 }
 
+// ---- general models, tiled (cuda-tiled): one thread block per tile of core/partition.hpp ----
+
+// A Tiling on the device; links[e].node is a cell of the member's own tile.
+struct TiledCsr {
+  const int* __restrict__ tile_offset;
+  const int* __restrict__ tile_node;
+  const int* __restrict__ members;
+  const int* __restrict__ link_offset;
+  const Link* __restrict__ links;
+};
+
+// Force pass: the block stages its tile's positions (and velocities, if damped) in shared
+// memory, then each member gathers its springs from there in the CSR order of gather_csr.
+template <bool Damped>
+__global__ void force_tiled_csr(StepParams s, TiledCsr t, const float4* __restrict__ x, const float4* __restrict__ v,
+                                float4* __restrict__ acc, Vec3f drag_target) {
+  extern __shared__ float4 sh[];
+  const int c0 = t.tile_offset[blockIdx.x], cells = t.tile_offset[blockIdx.x + 1] - c0;
+  float4* sv = sh + cells;
+  for (int c = threadIdx.x; c < cells; c += blockDim.x) {
+    const int g = t.tile_node[c0 + c];
+    sh[c] = x[g];
+    if (Damped) sv[c] = v[g];
+  }
+  __syncthreads();
+  if (int(threadIdx.x) >= t.members[blockIdx.x]) return;
+  const int p = c0 + threadIdx.x, i = t.tile_node[p];
+  const float4 x4 = sh[threadIdx.x], v4 = Damped ? sv[threadIdx.x] : v[i];
+  Vec3f a{};
+  if (!P::node_fixed(s, i, x4.w)) {
+    const Vec3f xi = xyz(x4), vi = xyz(v4);
+    Vec3f f{};
+    for (int e = t.link_offset[p]; e < t.link_offset[p + 1]; ++e) {
+      const Link l = t.links[e];
+      f += P::spring_force(xi, xyz(sh[l.node]), vi, Damped ? xyz(sv[l.node]) : vi, l.k, l.kd, l.rest);
+    }
+    a = P::node_acceleration(s, i, x4.w, xi, vi, f, drag_target);
+  }
+  acc[i] = f4(a, 0.f);
+}
+
 // ---- scatter: one thread per spring, atomics; then per node force sum -> acceleration ----
 
 __global__ void scatter_springs(const Spring* __restrict__ springs, std::int64_t count, const float4* __restrict__ x,

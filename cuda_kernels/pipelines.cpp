@@ -44,8 +44,11 @@ std::string unsupported(Integrator i) {
 
 std::int64_t spring_bytes(const ModelSize& m, Variant v) {
   if (m.grid) return 0;
-  // CSR: offsets and two 16-byte links per spring; scatter: 5 words per spring
-  return v == Variant::scatter ? m.springs * 20 : (m.nodes + 1) * 4 + 2 * m.springs * 16;
+  // CSR: offsets and two 16-byte links per spring; scatter: 5 words per spring; tiles: the
+  // CSR by tile cell, each cell's node (halos hold at most one cell per link) and tile bounds.
+  if (v == Variant::scatter) return m.springs * 20;
+  if (v == Variant::tiled) return (m.nodes + 2 * m.springs + 1) * 8 + 2 * m.springs * 16 + m.nodes * 8;
+  return (m.nodes + 1) * 4 + 2 * m.springs * 16;
 }
 
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
@@ -93,7 +96,8 @@ void add_cuda_pipelines(PipelineRegistry& r) {
   };
   const Entry entries[] = {
       {"cuda-naive", Variant::naive, "CUDA, one thread per node gathering its springs from global memory"},
-      {"cuda-tiled", Variant::tiled, "CUDA, gather from a shared-memory tile with a 2-node halo"},
+      {"cuda-tiled", Variant::tiled,
+       "CUDA, gather from shared-memory tiles (grids: the block with a 2-node halo; meshes: Z-order tiles with their halos)"},
       {"cuda-scatter", Variant::scatter, "CUDA, one thread per spring, atomic scatter of +f/-f"},
       {"cuda-fused", Variant::fused,
        "CUDA, force + update + constraints in one kernel (one-pass integrators; others use the plain gather)"},
