@@ -59,7 +59,7 @@ Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
   const std::int64_t n = m.nodes, node_buffers = 4 + (s.rule == UpdateRule::verlet ? 2 : 0) + 3 * s.stage_states +
                                                  (outside_forces ? 1 : 0);
   const std::int64_t chunk = 16 * std::min<std::int64_t>(n, kTransferChunkNodes);  // staging, host and GPU
-  const std::int64_t adjacency = m.grid ? 0 : (n + 1) * 4 + 2 * m.springs * 16;
+  const std::int64_t adjacency = m.grid || outside_forces ? 0 : (n + 1) * 4 + 2 * m.springs * 16;
   return {chunk, n * 16 * node_buffers + adjacency + chunk};
 }
 
@@ -76,17 +76,16 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   GLint max_texels = 0;
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
   max_texels_ = max_texels;
-  if (!m_.grid()) {  // general models read their adjacency through texture buffers
-    require_texels(n_ + 1, "the adjacency offsets");
-    require_texels(2 * m_.spring_count(), "the adjacency (two links per spring)");
-  }
+  const bool adjacency = !m_.grid() && !shared_;  // general models read it through texture buffers
+  if (adjacency) require_texels(n_ + 1, "the adjacency offsets");
   if (sched_.stage_states > 0) require_texels(n_, "the Runge-Kutta stage slopes");
   plan_windows(s.options);
+  if (adjacency) plan_link_views(s.options);
   require_memory(footprint(m_.size(), s.integrator, bool(shared_)).device);
   plan();
   make_buffers();
   upload_params();
-  if (!m_.grid()) upload_adjacency();
+  if (adjacency) upload_adjacency();
   const std::uint32_t zero = 0;
   result_ = make_buffer(4, &zero);
 }
@@ -114,24 +113,41 @@ void GlPipeline::require_memory(std::int64_t bytes) const {
                                 " of GL buffers; " + limit->name + " leaves " + gib(limit->bytes));
 }
 
+std::int64_t GlPipeline::count_option(const PipelineOptions& o, const std::string& name, std::int64_t most,
+                                      const std::string& limit) const {
+  const auto it = o.find(name);
+  if (it == o.end()) return most;
+  try {
+    std::size_t used = 0;
+    const std::int64_t v = std::stoll(it->second, &used);
+    if (used != it->second.size() || v < 1 || v > most) throw std::out_of_range("");
+    return v;
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument(name_ + ": option " + name + " '" + it->second + "' is not a count from 1 to " +
+                                std::to_string(most) + " (" + limit + ")");
+  }
+}
+
 void GlPipeline::plan_windows(const PipelineOptions& o) {
   GLint64 block = 0;
   GLint align = 1;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
   glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &align);
   max_block_nodes_ = block / 16;
-  std::int64_t window = max_block_nodes_;
-  if (const auto it = o.find("window"); it != o.end()) {
-    try {
-      std::size_t used = 0;
-      window = std::stoll(it->second, &used);
-      if (used != it->second.size() || window < 1 || window > max_block_nodes_) throw std::out_of_range("");
-    } catch (const std::logic_error&) {
-      throw std::invalid_argument(name_ + ": option window '" + it->second + "' is not a node count from 1 to " +
-                                  std::to_string(max_block_nodes_) + " (GL_MAX_SHADER_STORAGE_BLOCK_SIZE / 16)");
-    }
-  }
+  const std::int64_t window = count_option(o, "window", max_block_nodes_, "GL_MAX_SHADER_STORAGE_BLOCK_SIZE / 16");
   windows_ = node_windows(n_, spring_reach(m_), window, std::lcm<std::int64_t>(std::max(align, 1), 16) / 16);
+}
+
+void GlPipeline::plan_link_views(const PipelineOptions& o) {
+  GLint align = 1;
+  glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &align);
+  const std::int64_t step = std::lcm<std::int64_t>(std::max(align, 1), 16) / 16;  // texels between view starts
+  link_view_ = count_option(o, "link_view", max_texels_, "GL_MAX_TEXTURE_BUFFER_SIZE") / step * step;
+  const std::int64_t links = 2 * m_.spring_count(), views = (links + link_view_ - 1) / std::max<std::int64_t>(link_view_, 1);
+  if (link_view_ < 1 || views > kLinkViews)
+    throw std::invalid_argument(name_ + ": the adjacency's " + std::to_string(links) + " links (two per spring) need " +
+                                std::to_string(views) + " texture-buffer views of " + std::to_string(link_view_) +
+                                " texels; the shaders bind at most " + std::to_string(kLinkViews));
 }
 
 void GlPipeline::bind_nodes(GLuint index, const NodeBuffer& b, int first, int count) {
@@ -196,7 +212,9 @@ void GlPipeline::upload_adjacency() {
   adj_offset_ = make_buffer(m_.adj_offset.size() * 4, m_.adj_offset.data());
   links_ = make_buffer(links.size() * 4, links.data());
   adj_offset_tex_ = make_texture_buffer(adj_offset_.id(), GL_R32I);
-  links_tex_ = make_texture_buffer(links_.id(), GL_RGBA32F);
+  const std::int64_t texels = std::int64_t(links.size() / 4);
+  for (std::int64_t first = 0; first < texels; first += link_view_)
+    link_views_.push_back(make_texture_buffer(links_.id(), GL_RGBA32F, first * 16, std::min(link_view_, texels - first) * 16));
 }
 
 // One GPU pass per force pass of the schedule, with the update that follows it.
@@ -222,6 +240,7 @@ void GlPipeline::init() {
   static const char* kind_define[] = {"PASS_ONE", "PASS_STAGE", "PASS_RESULT"};
   const std::string common = "#define RULE " + std::to_string(int(rule_)) + "\n" +
                              (m_.grid() ? "#define TOPOLOGY_GRID 1\n" : "#define TOPOLOGY_GENERAL 1\n") +
+                             "#define LINK_VIEW " + std::to_string(std::max<std::int64_t>(link_view_, 1)) + "\n" +
                              (shared_ ? "#define EXTERNAL_FORCES 1\n" : "");
   for (GpuPass& g : passes_) {
     const int outputs = g.kind == PassKind::stage || rule_ == UpdateRule::verlet ? 3 : 2;
@@ -321,11 +340,13 @@ void GlPipeline::bind_textures(int stage) const {
     glActiveTexture(GL_TEXTURE5 + k);
     glBindTexture(GL_TEXTURE_BUFFER, k < stage ? sa_[k].tex.id() : 0);
   }
-  if (!m_.grid()) {
+  if (adj_offset_tex_.id()) {
     glActiveTexture(GL_TEXTURE8);
     glBindTexture(GL_TEXTURE_BUFFER, adj_offset_tex_.id());
-    glActiveTexture(GL_TEXTURE9);
-    glBindTexture(GL_TEXTURE_BUFFER, links_tex_.id());
+    for (std::size_t k = 0; k < link_views_.size(); ++k) {
+      glActiveTexture(k == 0 ? GL_TEXTURE9 : GLenum(GL_TEXTURE10 + k));
+      glBindTexture(GL_TEXTURE_BUFFER, link_views_[k].id());
+    }
   }
   glActiveTexture(GL_TEXTURE0);
 }

@@ -89,8 +89,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
-  // buffers it allocates, instead of evaluating forces. Option "window": nodes per
-  // storage-buffer window (default: the driver's limit).
+  // buffers it allocates, instead of evaluating forces. Options: "window", nodes per
+  // storage-buffer window; "link_view", links per texture-buffer view of a general model's
+  // adjacency (default for both: the driver's limit).
   GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared = {});
   // Throws std::invalid_argument naming the driver's limit when `texels` texels do not fit
   // in one texture buffer.
@@ -133,6 +134,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   void plan();
   void bind_textures(int stage) const;  // earlier stages' slopes and the adjacency
   void plan_windows(const PipelineOptions& o);
+  void plan_link_views(const PipelineOptions& o);
+  // The value of count option `name`, from 1 to `most`, else `most`.
+  std::int64_t count_option(const PipelineOptions& o, const std::string& name, std::int64_t most,
+                            const std::string& limit) const;
   // Throws std::invalid_argument when the GPU (or, for a software renderer, the host) has
   // less free memory than `bytes`.
   void require_memory(std::int64_t bytes) const;
@@ -145,7 +150,11 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass
   Buffer params_ubo_, adj_offset_, links_, result_;
-  Texture adj_offset_tex_, links_tex_;
+  Texture adj_offset_tex_;
+  // The links in views of link_view_ texels each (units 9, then 11.. in shaders/sim.glsl).
+  static constexpr int kLinkViews = 4;
+  std::vector<Texture> link_views_;
+  std::int64_t link_view_ = 0;
   Program reduce_, copy_;
   GLint reduce_n_ = -1, reduce_stride_ = -1, reduce_word_ = -1, copy_n_ = -1;
   std::int64_t max_texels_ = 0, max_block_nodes_ = 0;

@@ -24,11 +24,12 @@ Buffer make_buffer(std::size_t bytes, const void* data) {
   return b;
 }
 
-Texture make_texture_buffer(GLuint buffer, GLenum format) {
+Texture make_texture_buffer(GLuint buffer, GLenum format, std::int64_t offset, std::int64_t bytes) {
   GLuint id = 0;
   glGenTextures(1, &id);
   glBindTexture(GL_TEXTURE_BUFFER, id);
-  glTexBuffer(GL_TEXTURE_BUFFER, format, buffer);
+  if (bytes < 0) glTexBuffer(GL_TEXTURE_BUFFER, format, buffer);
+  else glTexBufferRange(GL_TEXTURE_BUFFER, format, buffer, GLintptr(offset), GLsizeiptr(bytes));
   glBindTexture(GL_TEXTURE_BUFFER, 0);
   return Texture(id);
 }

@@ -1,6 +1,7 @@
 // Owning wrappers for GL objects (moved, never copied), plus programs built from the
 // embedded shaders with their compile and link logs.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,8 +46,9 @@ using Program = Handle<delete_program>;
 
 // A buffer of `bytes` (data may be null), GL_DYNAMIC_COPY usage.
 Buffer make_buffer(std::size_t bytes, const void* data = nullptr);
-// A texture buffer view of `buffer` with the given texel format (GL_RGBA32F, GL_R32I, ...).
-Texture make_texture_buffer(GLuint buffer, GLenum format);
+// A texture-buffer view of `buffer` with the given texel format (GL_RGBA32F, GL_R32I, ...):
+// the whole buffer, or `bytes` from `offset` (a multiple of GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT).
+Texture make_texture_buffer(GLuint buffer, GLenum format, std::int64_t offset = 0, std::int64_t bytes = -1);
 void read_buffer(GLuint buffer, std::size_t offset, std::size_t bytes, void* out);
 
 struct ShaderStage {

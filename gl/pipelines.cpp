@@ -17,11 +17,12 @@ void add_gl_pipelines(PipelineRegistry& r) {
   // Deterministic, and equal to the CPU within rounding (the GPU's arithmetic differs).
   auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
   auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) { return gl::footprint(m, i, false); };
-  // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows).
+  // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows); "link_view":
+  // links per texture-buffer view of a mesh's adjacency.
   r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,
-         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window"}, footprint});
+         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window", "link_view"}, footprint});
   r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", on(Engine::gl_transform_feedback),
-         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {}, footprint});
+         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {"link_view"}, footprint});
 }
 
 }  // namespace deformlab

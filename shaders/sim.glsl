@@ -38,9 +38,20 @@ layout(binding = 2) uniform samplerBuffer u_stage_v[3];
 layout(binding = 5) uniform samplerBuffer u_stage_a[3];
 
 #ifdef TOPOLOGY_GENERAL
-// Node -> incident springs (CSR): offsets [n+1]; links [2s]: (other node's bits, rest, k, kd).
+// Node -> incident springs (CSR): offsets [n+1]; links [2s]: (other node's bits, rest, k, kd),
+// in views of LINK_VIEW texels (within the driver's texture-buffer limit): view 0 at unit 9,
+// views 1-3 at units 11-13.
 layout(binding = 8) uniform isamplerBuffer u_adj_offset;
 layout(binding = 9) uniform samplerBuffer u_links;
+layout(binding = 11) uniform samplerBuffer u_links_more[3];
+
+vec4 link(int e) {
+  if (e < LINK_VIEW) return texelFetch(u_links, e);
+  int view = e / LINK_VIEW, at = e - view * LINK_VIEW;
+  if (view == 1) return texelFetch(u_links_more[0], at);
+  if (view == 2) return texelFetch(u_links_more[1], at);
+  return texelFetch(u_links_more[2], at);
+}
 #endif
 
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
@@ -54,7 +65,7 @@ vec3 springs_on(int i, vec3 xi, vec3 vi) {
 #else
   int end = texelFetch(u_adj_offset, i + 1).x;
   for (int e = texelFetch(u_adj_offset, i).x; e < end; ++e) {
-    vec4 l = texelFetch(u_links, e);
+    vec4 l = link(e);
     int j = floatBitsToInt(l.x);
     f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, l.z, l.w, l.y);
   }

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 
+#include "core/mesh_model.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 #include "gl_test_support.hpp"
@@ -68,6 +69,28 @@ TEST(ComputeDispatch, WindowedPassesGiveTheSameBits) {
       const State a = advance(*whole, s0, 6), b = advance(*windowed, s0, 6);
       EXPECT_TRUE(bitwise_equal(a, b)) << m.nx << "x" << m.ny << "x" << m.nz << " " << info(i).name;
       EXPECT_EQ(whole->max_displacement(), windowed->max_displacement());
+    }
+  }
+}
+
+// A mesh's links beyond what the shaders' texture-buffer views hold are refused with the
+// counts (the split itself is checked against the CPU by tests/match, option link_view).
+TEST(LinkViews, TooManyViewsAndBadCountsAreRefused) {
+  DEFORMLAB_REQUIRE_GL();
+  Mesh mesh = triangulated_square(12, 10, 0.2f);
+  repair(mesh);
+  const Model m = mesh_model(mesh, Material{}, 0.f);
+  const Params p = small_params();
+  for (const char* name : {"glsl-tf", "glsl-compute"}) {
+    for (const char* bad : {"16", "0", "x"}) {
+      try {
+        make_gl(name, {m, p, Integrator::semi_implicit_euler, {{"link_view", bad}}});
+        ADD_FAILURE() << name << " accepted link_view=" << bad;
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(std::string(bad) == "16" ? "texture-buffer views" : "option link_view"),
+                  std::string::npos)
+            << e.what();
+      }
     }
   }
 }

@@ -47,10 +47,18 @@ const Shape kShapes[] = {
     {"volume8x6x5", 8, 6, 5, true, true, false, Shape::volume},
 };
 
-// Option values tried beyond the defaults, by option name (PipelineEntry::options).
-const std::pair<const char*, std::vector<std::string>> kOptionValues[] = {
-    {"force", {"tiled", "scatter"}},
-    {"interop", {"external", "external-gpusync", "staged"}},
+// Option values tried beyond the defaults, by option name (PipelineEntry::options), and the
+// shapes (kShapes) they are tried on.
+struct OptionValues {
+  const char* option;
+  std::vector<std::string> values;
+  std::vector<int> shapes;
+};
+const OptionValues kOptionValues[] = {
+    {"force", {"tiled", "scatter"}, {0, 3, 7, 8}},
+    {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
+    {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
+    {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
 };
 
 struct Case {
@@ -141,7 +149,7 @@ TEST_P(MatchCpu, FiftyStepsFromAMovingState) {
 }
 
 // The registry's pipelines x the integrators each runs x the shapes, with default options;
-// each non-default option value on two integrators (one and several force passes) and two shapes.
+// each non-default option value on two integrators (one and several force passes) and its shapes.
 std::vector<Case> cases() {
   std::vector<Case> out;
   for (const PipelineEntry& e : pipelines().all()) {
@@ -150,11 +158,11 @@ std::vector<Case> cases() {
       if (!e.unsupported(i.id).empty()) continue;
       for (int s = 0; s < int(std::size(kShapes)); ++s) out.push_back({e.name, i.id, s});
     }
-    for (const auto& [option, values] : kOptionValues) {
+    for (const auto& [option, values, shapes] : kOptionValues) {
       if (std::find(e.options.begin(), e.options.end(), option) == e.options.end()) continue;
       for (const std::string& v : values)
         for (Integrator i : {Integrator::semi_implicit_euler, Integrator::rk4})
-          for (int s : {0, 3}) out.push_back({e.name, i, s, {{option, v}}});
+          for (int s : shapes) out.push_back({e.name, i, s, {{option, v}}});
     }
   }
   return out;
