@@ -34,7 +34,7 @@ match_tests="$build/tests/match/deformlab_match_tests"
 if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
     {
-      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*'
+      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*'
       compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
