@@ -17,13 +17,15 @@ struct Row {
   json options;
 };
 
-// The sweep's measured cells of one integrator by (model, order, row label).
+// The sweep's cells of one integrator by (model, order the sweep names or "", row label).
 class ModelResults {
  public:
-  ModelResults(const std::vector<json>& cells, const std::string& integrator) {
+  ModelResults(const Sweep& s, const std::vector<json>& cells, const std::string& integrator) {
     for (const auto& c : cells)
-      if (c.contains("model") && c["integrator"] == integrator)
-        at_[key(c["model"], c.value("order", std::string()), label(c["pipeline"], c["options"]))] = &c;
+      if (c.contains("model") && c["integrator"] == integrator) {
+        const std::string order = s.orders.empty() ? "" : c.value("order", std::string());
+        at_[key(c["model"], order, label(c["pipeline"], c["options"]))] = &c;
+      }
   }
   const json* find(const std::string& model, const std::string& order, const std::string& row) const {
     const auto it = at_.find(key(model, order, row));
@@ -158,7 +160,7 @@ void write_order_ratios(std::ostringstream& md, ModelTable& t) {
   }
   md << "\n";
   for (const auto& [o, list] : by_order)
-    t.reading.push_back(t.model + ": " + o + " order against the file's costs " + extremes(list));
+    t.reading.push_back(t.model + ": " + o + " / file " + extremes(list));
 }
 
 // cuda-tiled and cuda-scatter against cuda-naive, the hybrids' force variants against naive,
@@ -237,7 +239,7 @@ void write_model_tables(std::ostringstream& md, const Sweep& sweep, const std::v
                         Notes& notes, std::vector<std::string>& reading) {
   const std::vector<Row> rows = rows_of(sweep);
   for (const auto& integ : sweep.integrators) {
-    const ModelResults res(cells, integ);
+    const ModelResults res(sweep, cells, integ);
     for (const auto& m : sweep.models) {
       md << "## Model `" << m.name << "`" << (sweep.integrators.size() > 1 ? ", " + integ : "") << "\n\n";
       ModelTable t{sweep, res, rows, ceil, notes, reading, m.name};

@@ -195,6 +195,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
   json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
             {"options", c.options}};
   if (!c.model.empty()) r["model"] = c.model;
+  if (!c.order.empty()) r["order"] = c.order;
   const PipelineEntry& e = *pipelines().find(c.pipeline);
   const Integrator integ = *parse_integrator(c.integrator);
   if (auto why = e.unavailable(); !why.empty()) return not_applicable(r, why);
