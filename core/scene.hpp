@@ -21,9 +21,8 @@ struct MeshShape {
   float cell_size = 0.f;
 };
 const char* to_string(MeshShape::Kind k);
-// The nodes Gmsh makes of a shape, estimated from its area or volume (nodes per h^2 of a
-// sheet and per h^3 of a box as measured on Gmsh 4.8's meshes: within 1% from 200 k nodes
-// up, 15% at 50 k, where a box's surface holds more of its nodes).
+// The nodes Gmsh makes of a shape, estimated from its area and rim (a sheet) or volume and
+// surface (a box), as measured on Gmsh 4.8's meshes: within 1% from 50 k nodes up.
 double estimated_nodes(const MeshShape& s);
 
 // A model read from a mesh file or generated (ModelSpec::topology general).

@@ -13,7 +13,7 @@ namespace {
 // Gmsh 4.8's 2D Delaunay slows down faster than linearly on one large surface (on 2 cores:
 // 64 k nodes/s at 80 k nodes, 17 k nodes/s at 330 k), so a sheet is meshed as a grid of
 // rectangles of about this many nodes each, sharing their edges (one conforming mesh; nodes
-// line up along the seams): 56 k nodes/s at 330 k nodes, 48 k nodes/s at 1.3 M.
+// line up along the seams, and Gmsh's order goes tile by tile).
 constexpr double kNodesPerTile = 5000;
 
 // The sheet as tiles x tiles plane surfaces of the built-in kernel, sharing points and lines.
@@ -44,13 +44,14 @@ void add_box(const MeshShape& s) {
 
 }  // namespace
 
-// Algorithms, as measured on a 2-core machine (nodes per second of generate(), Gmsh 4.8):
-// - sheets: 2D Delaunay (Mesh.Algorithm 5) over tiles, 56 k nodes/s at 330 k nodes against
-//   22 k for Frontal-Delaunay (6, which also makes 12% fewer nodes per area); Gmsh meshes the
-//   tiles on its 2D threads;
-// - boxes: HXT (Mesh.Algorithm3D 10), parallel, 65 k nodes/s at 490 k nodes on 2 threads
-//   (42 k on one) against 5.6 k for Delaunay (1, serial) at 130 k. Gmsh 4.8 runs HXT on one
-//   thread unless Mesh.MaxNumThreads3D is set, so every stage's thread count is set here.
+// Algorithms, as measured on a 2-core machine (Gmsh 4.8, generate_mesh alone):
+// - sheets: 2D Delaunay (Mesh.Algorithm 5) over tiles: 62 k nodes/s at 50 k nodes, 70 k at
+//   200 k, 83 k at 1 M; Frontal-Delaunay (6) made 22 k nodes/s at 330 k (and 12% fewer nodes
+//   per area). Gmsh meshes the tiles on its 2D threads.
+// - boxes: HXT (Mesh.Algorithm3D 10), parallel: 54 k nodes/s at 57 k nodes, 62 k at 210 k,
+//   39 k at 1 M on 2 threads (42 k at 490 k on one); Delaunay (1, serial) made 5.6 k nodes/s at
+//   130 k. Gmsh 4.8 runs HXT on one thread unless Mesh.MaxNumThreads3D is set, so every
+//   stage's thread count is set here.
 Mesh generate_mesh(const MeshShape& s) {
   GmshSession gmsh;
   Mesh m;
