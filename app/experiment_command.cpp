@@ -20,6 +20,7 @@ int experiment_command(const ExperimentArgs& a) {
     x = load_experiment_by_name(a.file);
     sweep = parse_sweep(x.raw, a.file);
     if (!sweep) throw std::invalid_argument(a.file + ": has no \"sweep\" (run it with `deformlab run --experiment`)");
+    if (a.max_size && !sweep->models.empty()) throw std::invalid_argument("--max-size: this sweep has models, not grid sizes");
     if (a.max_size) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
@@ -64,8 +65,7 @@ int experiment_command(const ExperimentArgs& a) {
       o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
         const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0;
-        std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.size
-                  << "²";
+        std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
           std::cout << ": " << std::setprecision(4) << r["median_ms"].get<double>() << " ms/step";

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "json_file.hpp"
@@ -13,6 +14,11 @@ namespace deformlab {
 using nlohmann::json;
 
 namespace {
+
+// Nodes of a Gmsh sheet per h^2 of its area and h of its rim, of a Gmsh box per h^3 of its
+// volume and h^2 of its surface, with cell size h (estimated_nodes; fitted to meshes of 50 k
+// to 1 M nodes).
+constexpr double kSheetPerArea = 1.314, kSheetPerRim = 0.631, kBoxPerVolume = 0.600, kBoxPerSurface = 0.952;
 
 [[noreturn]] void bad(const std::string& where, const std::string& what) {
   throw std::invalid_argument(where + ": " + what);
@@ -150,11 +156,48 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
   return t;
 }
 
+// "generate": {"shape": "sheet", "size": [w, d], "cell_size": h} or {"shape": "box", "size":
+// [w, h, d], ...}; refused before meshing where it would make more than 2^30 nodes.
+MeshShape shape(const json& j, const std::string& where) {
+  only_keys(j, where, {"shape", "size", "cell_size"});
+  for (const char* k : {"shape", "size", "cell_size"})
+    if (!j.contains(k)) bad(where, std::string("needs ") + k);
+  MeshShape s;
+  if (j["shape"] == "sheet") s.kind = MeshShape::Kind::sheet;
+  else if (j["shape"] == "box") s.kind = MeshShape::Kind::box;
+  else bad(where + ".shape", "expected \"sheet\" or \"box\"");
+  const bool sheet = s.kind == MeshShape::Kind::sheet;
+  const auto& z = j["size"];
+  if (!z.is_array() || z.size() != (sheet ? 2u : 3u))
+    bad(where + ".size", sheet ? "expected [w, d] (m) for a sheet" : "expected [w, h, d] (m) for a box");
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    const float v = num(z[k], where + ".size[" + std::to_string(k) + "]", Range::positive);
+    s.size[sheet && k == 1 ? 2 : int(k)] = v;
+  }
+  s.cell_size = num(j["cell_size"], where + ".cell_size", Range::positive);
+  if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30))
+    bad(where + ".cell_size", "would make about " + std::to_string(std::int64_t(n)) + " nodes, over the limit of 2^30");
+  return s;
+}
+
 void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std::string& dir) {
+  // One source: a file or a generated shape; naming one replaces the other (and, for a
+  // shape, a fill of the file).
+  if (j.contains("file") && j.contains("generate")) bad(where + ".generate", "give either \"file\" or \"generate\", not both");
+  for (const char* k : {"fill", "cell_size"})
+    if (j.contains("generate") && j.contains(k))
+      bad(where + "." + k, "fills a surface file; a generated mesh takes generate.cell_size");
   if (j.contains("file")) {
     if (!j["file"].is_string() || j["file"].get<std::string>().empty()) bad(where + ".file", "expected a file name");
     const std::filesystem::path f = j["file"].get<std::string>();
     m.file = (f.is_relative() && !dir.empty() ? std::filesystem::path(dir) / f : f).lexically_normal().string();
+    m.generate.reset();
+  }
+  if (j.contains("generate")) {
+    m.generate = shape(j["generate"], where + ".generate");
+    m.file.clear();
+    m.fill = false;
+    m.cell_size = 0.f;
   }
   if (j.contains("scale")) {
     if (j["scale"].is_number()) m.scale = Vec3f{1.f, 1.f, 1.f} * num(j["scale"], where + ".scale", Range::positive);
@@ -165,6 +208,7 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
   if (j.contains("transform")) m.transform = transform(j["transform"], where + ".transform");
   if (j.contains("density")) m.density = num(j["density"], where + ".density", Range::positive);
   if (j.contains("fill")) {
+    if (j["fill"] == "tetrahedra" && m.generate) bad(where + ".fill", "a generated mesh is not filled (a box is a volume already)");
     if (j["fill"] == "tetrahedra") m.fill = true;
     else if (j["fill"] == "none") m.fill = false;
     else bad(where + ".fill", "expected \"tetrahedra\" or \"none\"");
@@ -179,8 +223,8 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
 }
 
 void apply_model(ModelSpec& m, const json& j, const std::string& where, const std::string& dir) {
-  only_keys(j, where, {"type", "size", "spacing", "width", "height", "file", "scale", "transform", "density", "fill",
-                       "cell_size", "order", "seed", "node_mass", "stiffness", "damping", "pins"});
+  only_keys(j, where, {"type", "size", "spacing", "width", "height", "file", "generate", "scale", "transform", "density",
+                       "fill", "cell_size", "order", "seed", "node_mass", "stiffness", "damping", "pins"});
   if (j.contains("type")) {
     const auto t = j["type"].is_string() ? j["type"].get<std::string>() : "";
     if (t == "cloth") m.topology = Topology::cloth_grid;
@@ -191,7 +235,7 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   const bool mesh = m.topology == Topology::general;
   for (const char* k : {"size", "spacing", "width", "height"})
     if (mesh && j.contains(k)) bad(where + "." + k, "not a key of a mesh model (its size comes from the file)");
-  for (const char* k : {"file", "scale", "transform", "density", "fill", "cell_size", "order", "seed"})
+  for (const char* k : {"file", "generate", "scale", "transform", "density", "fill", "cell_size", "order", "seed"})
     if (!mesh && j.contains(k)) bad(where + "." + k, "a key of mesh models (\"type\": \"mesh\")");
   if (mesh) apply_mesh(m.mesh, j, where, dir);
   if (j.contains("size")) {
@@ -328,6 +372,14 @@ Params resolve_params(const Scene& s, const Model& m) {
   return p;
 }
 
+const char* to_string(MeshShape::Kind k) { return k == MeshShape::Kind::sheet ? "sheet" : "box"; }
+
+double estimated_nodes(const MeshShape& s) {
+  const double h = s.cell_size, x = s.size.x, y = s.size.y, z = s.size.z;
+  if (s.kind == MeshShape::Kind::sheet) return kSheetPerArea * x * z / (h * h) + kSheetPerRim * 2 * (x + z) / h;
+  return kBoxPerVolume * x * y * z / (h * h * h) + kBoxPerSurface * 2 * (x * y + y * z + z * x) / (h * h);
+}
+
 std::string describe(const ModelSpec& m) {
   switch (m.topology) {
     case Topology::cloth_grid: return "cloth " + std::to_string(m.nx) + "x" + std::to_string(m.ny);
@@ -335,7 +387,15 @@ std::string describe(const ModelSpec& m) {
       return "lattice " + std::to_string(m.nx) + "x" + std::to_string(m.ny) + "x" + std::to_string(m.nz);
     case Topology::general: break;
   }
-  return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + ", order " + to_string(m.mesh.order);
+  const std::string order = ", order " + std::string(to_string(m.mesh.order));
+  if (const auto& g = m.mesh.generate) {
+    std::ostringstream os;
+    os << "mesh: Gmsh " << to_string(g->kind) << " " << g->size.x << " x ";
+    if (g->kind == MeshShape::Kind::box) os << g->size.y << " x ";
+    os << g->size.z << " m, cell " << g->cell_size << " m" << order;
+    return os.str();
+  }
+  return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + order;
 }
 
 json to_json(const Scene& s) {
@@ -351,9 +411,15 @@ json to_json(const Scene& s) {
     const MeshSpec& ms = m.mesh;
     json rows = json::array();
     for (int r = 0; r < 3; ++r) rows.push_back({ms.transform[r * 4], ms.transform[r * 4 + 1], ms.transform[r * 4 + 2], ms.transform[r * 4 + 3]});
-    model.update({{"type", "mesh"}, {"file", ms.file}, {"scale", v3(ms.scale)}, {"transform", rows},
-                  {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size},
-                  {"order", to_string(ms.order)}, {"seed", ms.seed}});
+    model.update({{"type", "mesh"}, {"scale", v3(ms.scale)}, {"transform", rows}, {"order", to_string(ms.order)},
+                  {"seed", ms.seed}});
+    if (const auto& g = ms.generate) {
+      const bool sheet = g->kind == MeshShape::Kind::sheet;
+      model["generate"] = {{"shape", to_string(g->kind)}, {"cell_size", g->cell_size},
+                           {"size", sheet ? json::array({g->size.x, g->size.z}) : v3(g->size)}};
+    } else {
+      model.update({{"file", ms.file}, {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size}});
+    }
     if (ms.density > 0) model["density"] = ms.density;
   } else {
     model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"spacing", m.spacing},

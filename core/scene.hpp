@@ -2,6 +2,7 @@
 // unknown key or a value of the wrong type is an error naming the key path.
 #pragma once
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,9 +12,23 @@
 
 namespace deformlab {
 
-// A model read from a mesh file (ModelSpec::topology general).
+// A mesh made by Gmsh's unstructured meshers instead of read from a file: a triangle sheet
+// in the x-z plane (y = 0, centred on x = z = 0) or a tetrahedral box (centred on x = z = 0,
+// from y = 0 up), its elements' edges about `cell_size` long.
+struct MeshShape {
+  enum class Kind : std::uint8_t { sheet, box } kind = Kind::sheet;
+  Vec3f size{};  // m: sheet [w, 0, d] (x, z), box [w, h, d]
+  float cell_size = 0.f;
+};
+const char* to_string(MeshShape::Kind k);
+// The nodes Gmsh makes of a shape, estimated from its area and rim (a sheet) or volume and
+// surface (a box), as measured on Gmsh 4.8's meshes: within 1% from 50 k nodes up.
+double estimated_nodes(const MeshShape& s);
+
+// A model read from a mesh file or generated (ModelSpec::topology general).
 struct MeshSpec {
   std::string file;  // OBJ, PLY, STL, glTF (surfaces) or Gmsh .msh (volumes); relative to the scene file
+  std::optional<MeshShape> generate;  // instead of a file
   Vec3f scale{1.f, 1.f, 1.f};
   // Row-major affine map applied after the scale (the last row is 0 0 0 1).
   std::array<float, 12> transform{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -25,7 +40,7 @@ struct MeshSpec {
 };
 
 struct ModelSpec {
-  Topology topology = Topology::cloth_grid;  // general: a mesh file
+  Topology topology = Topology::cloth_grid;  // general: a mesh (read or generated)
   int nx = 128, ny = 128, nz = 1;
   float spacing = 0.f;  // 0: derived from `width` (cloth: width / (nx - 1))
   float width = 1.f;    // m, along x
@@ -61,7 +76,8 @@ Params resolve_params(const Scene& s, const Model& m);
 
 nlohmann::json to_json(const Scene& s);
 
-// "cloth 128x128", "lattice 8x8x8", "mesh data/bunny.ply filled with tetrahedra, order rcm"
+// "cloth 128x128", "lattice 8x8x8", "mesh data/bunny.ply filled with tetrahedra, order rcm",
+// "mesh: Gmsh sheet 1.0 x 1.0 m, cell 0.001 m, order rcm"
 std::string describe(const ModelSpec& m);
 
 }  // namespace deformlab

@@ -1,5 +1,7 @@
 #include "ceilings.hpp"
 
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/json_file.hpp"
@@ -62,20 +64,36 @@ json read_calibration(const std::filesystem::path& file) {
   return j;
 }
 
+double mesh_adjacency_bytes(std::int64_t nodes, std::int64_t springs) {
+  return nodes > 0 ? 4.0 + 16.0 * 2.0 * double(springs) / double(nodes) : 0.0;
+}
+
 std::optional<Bound> stage_ceiling(const Ceilings& c, const PipelineTraits& t, const std::string& stage,
-                                   std::int64_t nodes, Integrator integrator) {
+                                   std::int64_t nodes, Integrator integrator, double adjacency_b) {
   const double evals = info(integrator).force_passes, n = double(nodes) * evals;
-  if (stage == span::force) return pass_at(c, t.force, 48, n, "x, v read, a written once per evaluation (48 B/node)");
+  // "x, v read ... (48 B/node)", or with a mesh's adjacency "(48 + 196 = 244 B/node)".
+  auto per_node = [&](int state_b) {
+    std::ostringstream os;
+    if (adjacency_b > 0) {
+      const long adj = std::lround(adjacency_b);
+      os << "and the adjacency (" << state_b << " + " << adj << " = " << state_b + adj << " B/node)";
+    } else {
+      os << "(" << state_b << " B/node)";
+    }
+    return os.str();
+  };
+  if (stage == span::force)
+    return pass_at(c, t.force, 48 + adjacency_b, n, "x, v read, a written once per evaluation " + per_node(48));
   if (stage == span::update)
     return pass_at(c, t.update, 80, n, "x, v, a read, x, v written once per evaluation (80 B/node)");
   if (!t.hands_off()) {
     if (stage != span::step && stage != span::force_update) return std::nullopt;
-    return pass_at(c, t.force, 64, n, "x, v read and written once per evaluation (64 B/node)");
+    return pass_at(c, t.force, 64 + adjacency_b, n, "x, v read and written once per evaluation " + per_node(64));
   }
   if (stage == span::hand_off && c.floor_us > 0)
     return Bound{2 * evals * c.floor_us * 1e-3, "two hand-offs per evaluation at the floor"};
   if (stage != span::step) return std::nullopt;
-  const auto f = stage_ceiling(c, t, span::force, nodes, integrator);
+  const auto f = stage_ceiling(c, t, span::force, nodes, integrator, adjacency_b);
   const auto u = stage_ceiling(c, t, span::update, nodes, integrator);
   const auto h = stage_ceiling(c, t, span::hand_off, nodes, integrator);
   if (!f || !u || !h) return std::nullopt;

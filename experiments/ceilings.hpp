@@ -45,7 +45,14 @@ struct Bound {
   double ms;
   std::string what;
 };
+// `adjacency_b`: bytes per node a gather reads of a general model's adjacency beyond the
+// state (mesh_adjacency_bytes; grids: 0, their stencil is arithmetic), added to force passes.
 std::optional<Bound> stage_ceiling(const Ceilings& c, const PipelineTraits& traits, const std::string& stage,
-                                   std::int64_t nodes, Integrator integrator);
+                                   std::int64_t nodes, Integrator integrator, double adjacency_b = 0);
+
+// A mesh (CSR) gather's adjacency bytes per node: the offsets (4 B) and a 16-byte link per
+// incident spring end (2 s / n of them); neighbours' x and v are taken as served by a perfect
+// cache once. A fused mesh step then moves 64 + mesh_adjacency_bytes per node and evaluation.
+double mesh_adjacency_bytes(std::int64_t nodes, std::int64_t springs);
 
 }  // namespace deformlab

@@ -26,6 +26,7 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
     x.until_converged = b.until_converged;
     x.scene = b.scene;
   }
+  x.dir = dir;
   for (const auto& [k, v] : j.items()) {
     auto str = [&, &v = v, &k = k] {
       if (!v.is_string()) throw std::invalid_argument(where + "." + k + ": expected a string");
@@ -51,8 +52,8 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
 
 }  // namespace
 
-Experiment parse_experiment(const std::string& text, const std::string& where) {
-  return from_json(parse_json(text, "experiment file '" + where + "'"), where);
+Experiment parse_experiment(const std::string& text, const std::string& where, const std::string& dir) {
+  return from_json(parse_json(text, "experiment file '" + where + "'"), where, dir);
 }
 
 Experiment load_experiment(const std::string& path) {
@@ -62,12 +63,20 @@ Experiment load_experiment(const std::string& path) {
 Experiment load_experiment_by_name(const std::string& path_or_name) {
   if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos)
     if (const auto text = experiment_files::find(path_or_name + ".json"))
-      return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json");
+      return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_data_dir());
   return load_experiment(path_or_name);
 }
 
+std::string builtin_data_dir() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::path p = fs::read_symlink("/proc/self/exe", ec); !ec && p.has_relative_path(); p = p.parent_path())
+    if (fs::is_directory(p / "data", ec) && fs::is_directory(p / "experiments", ec)) return (p / "data").string();
+  return DEFORMLAB_SOURCE_DIR "/data";
+}
+
 Experiment default_experiment() {
-  return parse_experiment(std::string(experiment_files::paper_drag_json), "built-in paper-drag.json");
+  return parse_experiment(std::string(experiment_files::paper_drag_json), "built-in paper-drag.json", builtin_data_dir());
 }
 
 }  // namespace deformlab

@@ -14,14 +14,21 @@ struct Experiment {
   std::string integrator = "semi-implicit-euler";
   bool until_converged = true;
   Scene scene;
+  std::string dir;     // the folder its relative mesh files are taken from
   nlohmann::json raw;  // the whole file, for parts read elsewhere (the sweep) and manifests
 };
 
-// Parses experiment JSON text; `where` names it in errors (file name or "built-in ...").
-Experiment parse_experiment(const std::string& text, const std::string& where);
+// Parses experiment JSON text; `where` names it in errors (file name or "built-in ...");
+// relative mesh files are taken from `dir`.
+Experiment parse_experiment(const std::string& text, const std::string& where, const std::string& dir = "");
 Experiment load_experiment(const std::string& path);
-// A path to an experiment file, or the name of one built into the binary ("table1").
+// A path to an experiment file, or the name of one built into the binary ("table1"). A
+// built-in experiment's mesh files are taken from the source tree's data/ (builtin_data_dir).
 Experiment load_experiment_by_name(const std::string& path_or_name);
+// The data/ folder of the source tree this binary was built in: the first folder above the
+// running executable that holds data/ and experiments/ (a build inside a tree, wherever the
+// tree was moved), else the source tree it was configured from.
+std::string builtin_data_dir();
 // The built-in experiment that `deformlab run` runs with no arguments (experiments/paper-drag.json).
 Experiment default_experiment();
 

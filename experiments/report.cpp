@@ -23,33 +23,6 @@ struct Table {
   std::vector<Column> columns;
 };
 
-// Footnotes for cells not measured, one per distinct reason, listing where it applies.
-class Notes {
- public:
-  // The reason's footnote number.
-  std::size_t add(const std::string& reason, const std::string& where) {
-    for (std::size_t k = 0; k < notes_.size(); ++k)
-      if (notes_[k].first == reason) {
-        notes_[k].second.push_back(where);
-        return k + 1;
-      }
-    notes_.push_back({reason, {where}});
-    return notes_.size();
-  }
-  void write(std::ostringstream& md) const {
-    if (notes_.empty()) return;
-    md << "## Notes on cells\n\n";
-    for (std::size_t k = 0; k < notes_.size(); ++k) {
-      md << "[" << k + 1 << "] " << notes_[k].first << " (";
-      for (std::size_t w = 0; w < notes_[k].second.size(); ++w) md << (w ? ", " : "") << notes_[k].second[w];
-      md << ")\n\n";
-    }
-  }
-
- private:
-  std::vector<std::pair<std::string, std::vector<std::string>>> notes_;
-};
-
 // What the report's sections share while it is written.
 struct Report {
   fs::path dir;
@@ -253,7 +226,7 @@ void write_frames(Report& r) {
 
 void write_reading(Report& r) {
   if (r.reading.empty()) return;
-  r.md << "## Reading against the paper\n\n";
+  r.md << (r.sweep.models.empty() ? "## Reading against the paper\n\n" : "## Reading\n\n");
   for (const auto& line : r.reading) r.md << "- " << line << "\n";
   r.md << "\n";
 }
@@ -277,7 +250,10 @@ fs::path write_report(const fs::path& dir) {
   r.ceil = ceilings_of(manifest.value("calibration", json()));
   write_setup(r);
   write_method(r);
-  for (const Table& t : tables_of(r.sweep, r.by_pipeline)) write_table(r, t);
+  if (r.sweep.models.empty())
+    for (const Table& t : tables_of(r.sweep, r.by_pipeline)) write_table(r, t);
+  else
+    write_model_tables(r.md, r.sweep, r.cells, r.ceil, r.notes, r.reading);
   write_stages(r.md, dir, r.name, r.sweep, r.cells, r.ceil);
   write_frames(r);
   r.notes.write(r.md);

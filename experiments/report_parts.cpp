@@ -30,6 +30,11 @@ std::string options_label(const json& o) {
   return s;
 }
 
+std::string cell_label(const json& c) {
+  if (!c.contains("model")) return std::to_string(c["size"].get<int>()) + "²";
+  return c["model"].get<std::string>() + (c.contains("order") ? " " + c["order"].get<std::string>() : "");
+}
+
 namespace {
 
 std::string key(const std::string& p, const std::string& i, const json& o, int n) {

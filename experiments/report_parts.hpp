@@ -19,6 +19,36 @@ std::string fmt(double v);      // about 3 significant digits
 std::string percent(double v);  // "41%", "2.6%", "0.25%"
 std::string options_label(const nlohmann::json& options);  // "name=value, ..."
 
+// Footnotes for cells not measured, one per distinct reason, listing where it applies.
+class Notes {
+ public:
+  // The reason's footnote number.
+  std::size_t add(const std::string& reason, const std::string& where) {
+    for (std::size_t k = 0; k < notes_.size(); ++k)
+      if (notes_[k].first == reason) {
+        notes_[k].second.push_back(where);
+        return k + 1;
+      }
+    notes_.push_back({reason, {where}});
+    return notes_.size();
+  }
+  void write(std::ostringstream& md) const {
+    if (notes_.empty()) return;
+    md << "## Notes on cells\n\n";
+    for (std::size_t k = 0; k < notes_.size(); ++k) {
+      md << "[" << k + 1 << "] " << notes_[k].first << " (";
+      for (std::size_t w = 0; w < notes_[k].second.size(); ++w) md << (w ? ", " : "") << notes_[k].second[w];
+      md << ")\n\n";
+    }
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::vector<std::string>>> notes_;
+};
+
+// "64²" for a grid cell's result, "sheet-1m rcm" for a mesh model's.
+std::string cell_label(const nlohmann::json& cell);
+
 // The cells' results by (pipeline, integrator, options, size); a later cell of the same key
 // replaces an earlier one.
 class Results {
@@ -56,5 +86,11 @@ void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& colu
 // into `dir`.
 void write_stages(std::ostringstream& md, const std::filesystem::path& dir, const std::string& name,
                   const Sweep& sweep, const std::vector<nlohmann::json>& cells, const Ceilings& ceil);
+
+// Model sweeps: per integrator and mesh model, a table of pipelines (rows) by node order
+// (columns) in ms per step, each against the memory floor of a mesh step; the order, force
+// variant and hybrid ratios; and a reading of them appended to `reading`.
+void write_model_tables(std::ostringstream& md, const Sweep& sweep, const std::vector<nlohmann::json>& cells,
+                        const Ceilings& ceil, Notes& notes, std::vector<std::string>& reading);
 
 }  // namespace deformlab::report

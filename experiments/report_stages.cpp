@@ -59,7 +59,7 @@ Group group_of(const Cell& c, const std::vector<json>& cells) {
     if (r["status"] == "ok" && r.contains("stages") && r["pipeline"] == c.pipeline && r["integrator"] == c.integrator &&
         r["options"] == json(c.options))
       g.rows.push_back(&r);
-  std::sort(g.rows.begin(), g.rows.end(),
+  std::stable_sort(g.rows.begin(), g.rows.end(),
             [](const json* a, const json* b) { return (*a)["size"].get<int>() < (*b)["size"].get<int>(); });
   for (const json* r : g.rows)
     for (const auto& st : (*r)["stages"]) {
@@ -80,7 +80,7 @@ std::vector<Group> stage_groups(const Sweep& sweep, const std::vector<json>& cel
 }
 
 void write_stage_head(std::ostringstream& md, const Group& g, bool hands_off, const Ceilings& ceil) {
-  md << "### " << g.label << "\n\n| grid | step ms |";
+  md << "### " << g.label << "\n\n| " << (g.rows.front()->contains("model") ? "model" : "grid") << " | step ms |";
   for (const auto& st : g.gpu_stages) md << " " << st << " ms |";
   md << " rest ms |";
   for (const auto& st : g.host_stages) md << " " << st << " (CPU) ms |";
@@ -102,8 +102,9 @@ plot::Stack write_stage_row(std::ostringstream& md, const Group& g, const json& 
       if (e["name"] == st) return e["median_ms"].get<double>();
     return std::nullopt;
   };
-  md << "| " << r["size"].get<int>() << "² | " << fmt(step) << " |";
-  plot::Stack bar{std::to_string(r["size"].get<int>()) + "² " + fmt(step) + " ms", {}};
+  md << "| " << cell_label(r) << " | " << fmt(step) << " |";
+  plot::Stack bar{cell_label(r) + " " + fmt(step) + " ms", {}};
+  const double adjacency_b = r.contains("model") ? mesh_adjacency_bytes(r["nodes"], r["springs"]) : 0;
   double gpu = 0;
   for (const auto& st : g.gpu_stages) {
     const auto v = stage_ms(st);
@@ -114,7 +115,7 @@ plot::Stack write_stage_row(std::ostringstream& md, const Group& g, const json& 
     }
     gpu += *v;
     md << " " << fmt(*v);
-    if (const auto b = stage_ceiling(ceil, traits, st, r["nodes"].get<std::int64_t>(), integ))
+    if (const auto b = stage_ceiling(ceil, traits, st, r["nodes"].get<std::int64_t>(), integ, adjacency_b))
       md << " (" << percent(100 * b->ms / *v) << ")";
     md << " |";
   }

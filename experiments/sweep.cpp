@@ -13,6 +13,7 @@
 #include "mesh/scene_model.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
+#include "sweep_models.hpp"
 #if DEFORMLAB_HAVE_GL
 #include "gl/context.hpp"
 #include "gl/render.hpp"
@@ -24,11 +25,17 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 std::string Cell::id() const {
-  std::string s = pipeline + "__" + integrator + "__" + std::to_string(size);
+  std::string s = pipeline + "__" + integrator + "__" + (model.empty() ? std::to_string(size) : model);
+  if (!order.empty()) s += "__" + order;
   for (const auto& [k, v] : options) s += "__" + k + "-" + v;
   for (char& ch : s)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
   return s;
+}
+
+std::string Cell::label() const {
+  if (model.empty()) return std::to_string(size) + "²";
+  return order.empty() ? model : model + " " + order;
 }
 
 namespace {
@@ -65,7 +72,9 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     if (k == "sizes") {
       if (!v.is_array() || v.empty()) bad(w + ".sizes", "expected a non-empty list of sizes");
       for (const auto& n : v) s.sizes.push_back(positive(n, w + ".sizes"));
-    } else if (k == "pipelines") s.pipelines = strings(v, w + ".pipelines");
+    } else if (k == "models") s.models = parse_sweep_models(v, w + ".models");
+    else if (k == "orders") s.orders = parse_sweep_orders(v, w + ".orders");
+    else if (k == "pipelines") s.pipelines = strings(v, w + ".pipelines");
     else if (k == "integrators") s.integrators = strings(v, w + ".integrators");
     else if (k == "options") {
       if (!v.is_array() || v.empty()) bad(w + ".options", "expected a non-empty list of option objects");
@@ -96,10 +105,11 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
         bad(w + ".paper_table", "expected \"table1\", \"table2\" or \"table3\"");
       s.paper_table = v.get<std::string>();
     } else
-      bad(w + "." + k, "unknown key (expected sizes, pipelines, integrators, options, warmup, steps, "
-                       "repetitions, cell_limit_s, time, frames, paper_table)");
+      bad(w + "." + k, "unknown key (expected sizes, models, orders, pipelines, integrators, options, warmup, "
+                       "steps, repetitions, cell_limit_s, time, frames, paper_table)");
   }
-  if (s.sizes.empty()) bad(w, "needs sizes");
+  if (s.sizes.empty() == s.models.empty()) bad(w, "needs either sizes or models");
+  if (!s.orders.empty() && s.models.empty()) bad(w + ".orders", "node orders go with models");
   if (s.pipelines.empty()) bad(w, "needs pipelines");
   if (s.integrators.empty()) s.integrators = {x.value("integrator", std::string("semi-implicit-euler"))};
   if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};
@@ -119,10 +129,15 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
 }
 
 std::vector<Cell> cells(const Sweep& s) {
-  // Sizes outside pipelines, so that consecutive cells share one model.
+  // Sizes (models, orders) outside pipelines, so that consecutive cells share one model.
+  std::vector<Cell> models;
+  for (int n : s.sizes) models.push_back({n, "", "", {}});
+  for (const auto& m : s.models)
+    for (const auto& o : s.orders.empty() ? std::vector<std::string>{""} : s.orders)
+      models.push_back({0, "", "", {}, m.name, o});
   std::vector<Cell> out;
   for (const auto& integ : s.integrators)
-    for (int n : s.sizes)
+    for (const Cell& model : models)
       for (const auto& pipe : s.pipelines) {
         // A pipeline runs the option sets whose every name it reads; with none, it runs once.
         const auto& accepted = pipelines().find(pipe)->options;
@@ -133,7 +148,7 @@ std::vector<Cell> cells(const Sweep& s) {
               }) && (!o.empty() || sets.empty()))
             sets.push_back(o);
         if (sets.empty()) sets.push_back({});
-        for (const auto& o : sets) out.push_back({n, pipe, integ, o});
+        for (const auto& o : sets) out.push_back({model.size, pipe, integ, o, model.model, model.order});
       }
   return out;
 }
@@ -267,7 +282,7 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   prog.total = int(all.size());
   const auto start = clock::now();
   int ran = 0;
-  ModelCache cache;
+  ModelCache cache;  // freed before the frames are rendered
   for (const auto& c : all) {
     const fs::path file = dir / "cells" / (c.id() + ".json");
     // A measured cell is done; an n/a one is tried again (the build or machine may differ).
@@ -283,6 +298,7 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     prog.elapsed_s = std::chrono::duration<double>(clock::now() - start).count();
     if (o.on_cell) o.on_cell(c, r, prog);
   }
+  cache = {};
   if (s.frames > 0 && !fs::exists(dir / "frames")) {
     manifest["frames"] = render_frames(x, s, dir);
     write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");

@@ -1,5 +1,5 @@
-// Sweeps: an experiment file's "sweep" names grid sizes x pipelines x integrators x
-// pipeline option sets (tile shapes, interop modes, force/update backends). The runner
+// Sweeps: an experiment file's "sweep" names grid sizes (or mesh models x node orders) x
+// pipelines x integrators x pipeline option sets (tile shapes, interop modes, force/update backends). The runner
 // times every cell, skips cells already done, bounds each cell's time, records "n/a" with
 // the reason where a cell is cut or cannot run, and writes each result atomically.
 #pragma once
@@ -12,12 +12,21 @@
 #include <vector>
 
 #include "core/pipeline.hpp"
+#include "core/scene.hpp"
 #include "experiment.hpp"
 
 namespace deformlab {
 
+// A mesh model of a sweep: a scene "model" object applied over the experiment's model.
+struct SweepModel {
+  std::string name;  // letters, digits, '-', '_' and '.'
+  nlohmann::json model;
+};
+
 struct Sweep {
   std::vector<int> sizes;                     // n for an n x n cloth (or n^3 lattice)
+  std::vector<SweepModel> models;             // or mesh models (exactly one of the two)
+  std::vector<std::string> orders;            // node orders of the models (empty: each model's own)
   std::vector<std::string> pipelines;
   std::vector<std::string> integrators;       // default: the experiment's integrator
   std::vector<PipelineOptions> option_sets;   // each pipeline runs those whose names it reads
@@ -31,10 +40,13 @@ struct Sweep {
 };
 
 struct Cell {
-  int size = 0;
+  int size = 0;  // a grid size, or 0 for a mesh model
   std::string pipeline, integrator;
   PipelineOptions options;
-  std::string id() const;  // file-name safe, unique within a sweep
+  std::string model;  // a mesh model's name
+  std::string order;  // its node order ("": the model's own)
+  std::string id() const;     // file-name safe, unique within a sweep
+  std::string label() const;  // "64²", "sheet-1m rcm"
 };
 
 std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::string& where);
@@ -59,14 +71,27 @@ struct SweepOptions {
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
 
-// The last model built, reused by the next cell of the same size.
-struct ModelCache {
-  int size = 0;
-  std::unique_ptr<Model> model;
+// The models of the cells at hand, each built once and freed when the sweep moves on: a grid
+// per size; a mesh read or generated once per model name (kept in its file's order while that
+// model's cells run) and ordered once per (name, order). At most two models are held: the
+// file's order and one other.
+class ModelCache {
+ public:
+  // The model of `c`, whose scene is `scene`.
+  const Model& model(const Scene& scene, const Cell& c);
+  int meshes_built() const { return bases_; }   // grids or meshes in the file's order
+  int models_built() const { return models_; }  // distinct (size or name, order) models handed out
+
+ private:
+  std::string base_key_, order_key_;
+  std::unique_ptr<Model> base_, ordered_;
+  int bases_ = 0, models_ = 0;
 };
 
 // One cell's result: {"status": "ok", "median_ms", ..., "stages": [{"name", "median_ms",
-// "clock", "per_step"}] for pipelines that time their stages} or {"status": "n/a", "reason"}.
+// "clock", "per_step"}] for pipelines that time their stages} or {"status": "n/a", "reason"};
+// "nodes", "springs", "model_build_s" (0: a model built for an earlier cell) and, for mesh
+// models, "model", "order", "mesh" ("surface" or "volume") and "bandwidth".
 nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
 
 // Frames of the experiment's own scene (its model, not a sweep size) on the best pipeline

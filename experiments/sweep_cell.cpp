@@ -6,10 +6,11 @@
 
 #include "core/scene.hpp"
 #include "core/state.hpp"
-#include "mesh/scene_model.hpp"
+#include "core/node_order.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
 #include "sweep.hpp"
+#include "sweep_models.hpp"
 #if DEFORMLAB_HAVE_GL
 #include "gl/context.hpp"
 #include "gl/render.hpp"
@@ -29,9 +30,9 @@ json not_applicable(json r, const std::string& why) {
   return r;
 }
 
-// Sizes the scene's model to the cell and records its nodes and springs in `r`; returns why
-// it does not fit here, else "".
-std::string size_model(Scene& scene, const Cell& c, const PipelineEntry& e, Integrator i, json& r) {
+// Sizes the scene's grid to the cell and records its nodes and springs in `r`; returns why it
+// does not fit here, else "".
+std::string size_grid(Scene& scene, const Cell& c, const PipelineEntry& e, Integrator i, json& r) {
   ModelSpec& ms = scene.model;
   ms.nx = ms.ny = c.size;
   ms.nz = ms.topology == Topology::lattice ? c.size : 1;
@@ -42,13 +43,25 @@ std::string size_model(Scene& scene, const Cell& c, const PipelineEntry& e, Inte
   return why.empty() ? why : "does not fit: " + why;
 }
 
-const Model& cached_model(ModelCache& cache, const Scene& scene, int size) {
-  if (cache.size != size || !cache.model) {
-    cache.model.reset();  // free the old one before building the next
-    cache.model = std::make_unique<Model>(build_model(scene));
-    cache.size = size;
-  }
-  return *cache.model;
+// "volume" for a mesh with nodes inside its surface (Model::triangle, a volume's boundary),
+// else "surface" (every node of a surface is on a triangle).
+std::string mesh_kind(const Model& m) {
+  std::vector<bool> on_surface(m.node_count(), false);
+  for (auto v : m.triangle) on_surface[v] = true;
+  return std::find(on_surface.begin(), on_surface.end(), false) != on_surface.end() ? "volume" : "surface";
+}
+
+// A mesh model's facts in `r` once it is built; returns why the cell does not fit here, else
+// "" (the model counted again beside what it already holds, as `deformlab run` counts it).
+std::string record_mesh(const Model& m, const Scene& scene, const Cell& c, const PipelineEntry& e, Integrator i,
+                        json& r) {
+  r["nodes"] = m.node_count();
+  r["springs"] = m.spring_count();
+  r["mesh"] = mesh_kind(m);
+  r["order"] = to_string(scene.model.mesh.order);
+  r["bandwidth"] = bandwidth(m);
+  const std::string why = host_memory_shortfall(m.size(), e, i, c.options);
+  return why.empty() ? why : "does not fit: " + why;
 }
 
 // A cell's steps. With "frame" timing every step is followed by a draw of the state at
@@ -181,14 +194,22 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
 json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache) {
   json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
             {"options", c.options}};
+  if (!c.model.empty()) r["model"] = c.model;
+  if (!c.order.empty()) r["order"] = c.order;
   const PipelineEntry& e = *pipelines().find(c.pipeline);
   const Integrator integ = *parse_integrator(c.integrator);
   if (auto why = e.unavailable(); !why.empty()) return not_applicable(r, why);
   if (auto why = e.unsupported(integ); !why.empty()) return not_applicable(r, why);
-  Scene scene = x.scene;
-  if (auto why = size_model(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
   try {
-    const Model& m = cached_model(cache, scene, c.size);
+    Scene scene = c.model.empty() ? x.scene : model_cell_scene(x, s, c);
+    if (c.model.empty())
+      if (auto why = size_grid(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
+    const int built = cache.models_built();
+    const auto t0 = clock::now();
+    const Model& m = cache.model(scene, c);
+    r["model_build_s"] = cache.models_built() == built ? 0.0 : std::chrono::duration<double>(clock::now() - t0).count();
+    if (!c.model.empty())
+      if (auto why = record_mesh(m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
     return measure(r, *pipe, m, s);

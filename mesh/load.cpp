@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "gmsh_session.hpp"
+
 namespace deformlab {
 
 namespace {
@@ -54,33 +56,8 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   return m;
 }
 
-// Gmsh for the length of one task; its errors become exceptions with Gmsh's message.
-class GmshSession {
- public:
-  GmshSession() {
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.AbortOnError", 2);
-  }
-  ~GmshSession() { gmsh::finalize(); }
-  GmshSession(const GmshSession&) = delete;
-  GmshSession& operator=(const GmshSession&) = delete;
+}  // namespace
 
-  template <class F>
-  static void run(const std::string& what, F&& f) {
-    try {
-      f();
-    } catch (const std::invalid_argument&) {
-      throw;
-    } catch (...) {
-      std::string error;
-      gmsh::logger::getLastError(error);
-      throw std::invalid_argument(what + ": " + (error.empty() ? "Gmsh failed" : error));
-    }
-  }
-};
-
-// The current Gmsh model's linear tetrahedra or, if it has none, its triangles.
 Mesh read_gmsh_model(const std::string& what) {
   std::vector<std::size_t> tags;
   std::vector<double> coord, param;
@@ -126,7 +103,6 @@ Mesh read_gmsh_model(const std::string& what) {
   return m;
 }
 
-}  // namespace
 
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   std::error_code ec;

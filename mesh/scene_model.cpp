@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/memory.hpp"
+#include "generate.hpp"
 #include "load.hpp"
 
 namespace deformlab {
@@ -30,11 +31,22 @@ void check_memory(const Mesh& mesh) {
                                 limit->name + " leaves " + gib(limit->bytes));
 }
 
-Model mesh_from_file(const ModelSpec& spec) {
+// The mesh the spec names: read from its file or generated; what names it in errors.
+Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
+  if (ms.generate) {
+    what = "generated " + std::string(to_string(ms.generate->kind));
+    return generate_mesh(*ms.generate);
+  }
+  if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file) or a shape (model.generate)");
+  what = "mesh file '" + ms.file + "'";
+  return load_mesh(ms.file, notes);
+}
+
+Model mesh_model_of(const ModelSpec& spec) {
   const MeshSpec& ms = spec.mesh;
-  if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file)");
   std::vector<std::string> notes;
-  Mesh mesh = load_mesh(ms.file, notes);
+  std::string what;
+  Mesh mesh = source_mesh(ms, what, notes);
   place(mesh, ms);
   try {
     for (auto& line : repair(mesh)) notes.push_back(std::move(line));
@@ -48,17 +60,17 @@ Model mesh_from_file(const ModelSpec& spec) {
     m.repairs = std::move(notes);
     return m;
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("mesh file '" + ms.file + "': " + e.what());
+    throw std::invalid_argument(what + ": " + e.what());
   }
 }
 
 }  // namespace
 
-Model build_model(const Scene& s) {
+Model build_model_in_file_order(const Scene& s) {
   const ModelSpec& m = s.model;
   Model model;
   if (m.topology == Topology::general) {
-    model = mesh_from_file(m);
+    model = mesh_model_of(m);
   } else {
     if (m.nx < 1 || m.ny < 1 || m.nz < 1) throw std::invalid_argument("model size must be positive in every dimension");
     float h = m.spacing;
@@ -67,8 +79,17 @@ Model build_model(const Scene& s) {
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
   }
   pin(model, pin_nodes(model, m.pins, m.pin_list));  // before reordering: indices are the file's
+  return model;
+}
+
+void apply_node_order(Model& model, const ModelSpec& m) {
   if (m.topology == Topology::general && m.mesh.order != NodeOrder::file)
     reorder(model, node_order(model, m.mesh.order, m.mesh.seed));
+}
+
+Model build_model(const Scene& s) {
+  Model model = build_model_in_file_order(s);
+  apply_node_order(model, s.model);
   return model;
 }
 

@@ -30,6 +30,11 @@ BadInput mesh(const char* name, const std::string& model, const std::string& key
   return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", scene}, {file, text}}};
 }
 
+// A scene whose mesh model is generated from `generate` (its JSON, which may go on with more keys of the model).
+std::string G(const std::string& generate) {
+  return "{\"model\": {\"type\": \"mesh\", \"pins\": \"none\", \"generate\": " + generate + "}}";
+}
+
 const std::vector<BadInput>& cases() {
   static const std::vector<BadInput> all = {
       // flags
@@ -138,6 +143,28 @@ const std::vector<BadInput>& cases() {
            "pins[0]: the box holds no node of the model"),
       mesh("mesh_pins_box_corners", "{\"file\": \"m.obj\", \"pins\": {\"box\": [[1, 1, 1], [0, 0, 0]]}}",
            "s.json.model.pins.box: the first corner must be the lowest"),
+      // generated meshes
+      scene("generate_shape", G(R"({"shape": "disc", "size": [1, 1], "cell_size": 0.1})"),
+            "s.json.model.generate.shape: expected \"sheet\" or \"box\""),
+      scene("generate_sheet_arity", G(R"({"shape": "sheet", "size": [1, 1, 1], "cell_size": 0.1})"),
+            "s.json.model.generate.size: expected [w, d] (m) for a sheet"),
+      scene("generate_box_arity", G(R"({"shape": "box", "size": [1, 1], "cell_size": 0.1})"),
+            "s.json.model.generate.size: expected [w, h, d] (m) for a box"),
+      scene("generate_size_zero", G(R"({"shape": "box", "size": [1, 0, 1], "cell_size": 0.1})"),
+            "s.json.model.generate.size[1]: expected a number > 0"),
+      scene("generate_size_negative", G(R"({"shape": "sheet", "size": [-1, 1], "cell_size": 0.1})"),
+            "s.json.model.generate.size[0]: expected a number > 0"),
+      scene("generate_cell_zero", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0})"),
+            "s.json.model.generate.cell_size: expected a number > 0"),
+      scene("generate_no_cell", G(R"({"shape": "sheet", "size": [1, 1]})"), "s.json.model.generate: needs cell_size"),
+      scene("generate_key", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1, "algo": 5})"),
+            "s.json.model.generate.algo: unknown key"),
+      scene("generate_too_many_nodes", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.0001})"),
+            "s.json.model.generate.cell_size: would make about"),
+      scene("generate_and_file", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1}, "file": "m.obj")"),
+            "s.json.model.generate: give either \"file\" or \"generate\", not both"),
+      scene("generate_and_fill", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.1}, "fill": "tetrahedra")"),
+            "s.json.model.fill: fills a surface file"),
       scene("grid_mesh_key", "{\"model\": {\"file\": \"m.obj\"}}", "s.json.model.file: a key of mesh models"),
       scene("drag_node_box", "{\"drag\": {\"node\": {\"box\": [[0, 0, 0], [1, 1, 1]]}}}",
             "s.json.drag.node: expected a node index, \"center\" or {\"nearest\": [x, y, z]}"),
@@ -154,6 +181,20 @@ const std::vector<BadInput>& cases() {
        {{"x.json", "{\"scene\": {\"dt\": -1}}"}}},
       {"sweep_option_unread", "experiment {dir}/x.json", "x.json.sweep.options.tyle: no pipeline of this sweep reads option 'tyle'",
        {{"x.json", "{\"sweep\": {\"sizes\": [8], \"pipelines\": [\"cpu\"], \"options\": [{\"tyle\": \"8x8\"}]}}"}}},
+      {"sweep_sizes_and_models", "experiment {dir}/x.json", "x.json.sweep: needs either sizes or models",
+       {{"x.json", R"({"sweep": {"sizes": [8], "models": [{"name": "a", "model": {"file": "m.obj"}}], "pipelines": ["cpu"]}})"}}},
+      {"sweep_orders_without_models", "experiment {dir}/x.json", "x.json.sweep.orders: node orders go with models",
+       {{"x.json", R"({"sweep": {"sizes": [8], "orders": ["rcm"], "pipelines": ["cpu"]}})"}}},
+      {"sweep_order_unknown", "experiment {dir}/x.json", "x.json.sweep.orders: expected a list of: file, shuffled",
+       {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"file": "m.obj"}}], "orders": ["hilbert"], "pipelines": ["cpu"]}})"}}},
+      {"sweep_model_name", "experiment {dir}/x.json", "x.json.sweep.models[0].name: expected a name of letters",
+       {{"x.json", R"({"sweep": {"models": [{"name": "a/b", "model": {"file": "m.obj"}}], "pipelines": ["cpu"]}})"}}},
+      {"sweep_model_twice", "experiment {dir}/x.json", "x.json.sweep.models[1].name: model 'a' is named twice",
+       {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"file": "m.obj"}}, {"name": "a", "model": {"file": "n.obj"}}], "pipelines": ["cpu"]}})"}}},
+      {"sweep_model_key", "experiment {dir}/x.json", "x.json.sweep.models[0].model.generate.shape: expected",
+       {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"generate": {"shape": "cone", "size": [1, 1], "cell_size": 1}}}], "pipelines": ["cpu"]}})"}}},
+      {"sweep_models_max_size", "experiment {dir}/x.json --max-size 8", "--max-size: this sweep has models",
+       {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"file": "m.obj"}}], "pipelines": ["cpu"]}})"}}},
       {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_max_size_zero", "experiment quick --max-size 0", "--max-size: Value 0 not in range 1 to 1048576"},

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "experiments/experiment.hpp"
@@ -96,6 +97,63 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   } else {
     EXPECT_NE(manifest["frames"]["unavailable"].get<std::string>().find("OpenGL"), std::string::npos);
   }
+}
+
+// Mesh models x node orders: every cell measured, ids distinct, each mesh generated or read
+// once and each (model, order) built once, the report's tables per model, a resumed folder
+// skipping what is done.
+TEST_F(SweepTest, ModelsByOrders) {
+  const Experiment x = parse_experiment(R"({"name": "meshes-tiny", "base": "meshes", "sweep": {
+      "models": [{"name": "sheet", "model": {"generate": {"shape": "sheet", "size": [0.2, 0.2], "cell_size": 0.02},
+                                             "scale": 1, "transform": {"translate": [0, 0.3, 0]}}},
+                 {"name": "bunny-shell", "model": {"file": "bunny/bunny.obj", "fill": "none"}}],
+      "orders": ["file", "shuffled", "rcm"], "pipelines": ["cpu", "omp"],
+      "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})", "tiny.json", builtin_data_dir());
+  const Sweep s = *parse_sweep(x.raw, "tiny");
+  const auto all = cells(s);
+  ASSERT_EQ(all.size(), 12u);
+  std::set<std::string> ids;
+  for (const auto& c : all) EXPECT_TRUE(ids.insert(c.id()).second) << c.id();
+  EXPECT_EQ(all[0].id(), "cpu__semi-implicit-euler__sheet__file");
+  ModelCache cache;
+  for (const auto& c : all) {
+    const json r = run_cell(x, s, c, cache);
+    ASSERT_EQ(r["status"], "ok") << r.dump();
+    EXPECT_EQ(r["order"], c.order);
+    EXPECT_EQ(r["mesh"], "surface");
+    EXPECT_GT(r["bandwidth"].get<int>(), 0);
+  }
+  EXPECT_EQ(cache.meshes_built(), 2);
+  EXPECT_EQ(cache.models_built(), 6);
+
+  EXPECT_EQ(run_sweep(x, s, dir_, {}, json::array()), 12);
+  int built = 0;
+  for (const auto& r : load_cells(dir_)) built += r["model_build_s"].get<double>() > 0;
+  EXPECT_EQ(built, 6);  // the second pipeline of each (model, order) reuses the first's model
+  fs::remove(dir_ / "cells" / (all[5].id() + ".json"));
+  EXPECT_EQ(run_sweep(x, s, dir_, {}, json::array()), 1);
+  const std::string md = slurp(write_report(dir_));
+  EXPECT_NE(md.find("## Model `bunny-shell`\n\nsurface, 1839 nodes"), std::string::npos) << md;
+  EXPECT_NE(md.find("| pipeline | file | shuffled | rcm |\n|---|---|---|---|\n| bandwidth |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| pipeline | shuffled / file | rcm / file |"), std::string::npos) << md;
+  EXPECT_NE(md.find("68 + 32 s/n = "), std::string::npos) << md;
+  EXPECT_NE(md.find("## Reading\n\n- sheet: "), std::string::npos) << md;
+  // With a calibration: each step against the mesh step's floor (1839 nodes x 252.3 B at 1000 GB/s).
+  json manifest = json::parse(slurp(dir_ / "manifest.json"));
+  manifest["calibration"] = {{"copy", {{"GB_per_s", 1000.0}}}};
+  std::ofstream(dir_ / "manifest.json") << manifest.dump();
+  const std::string with = slurp(write_report(dir_));
+  EXPECT_NE(with.find("at the CUDA copy bandwidth (1000.0 GB/s): 0.000464 ms"), std::string::npos) << with;
+}
+
+// The built-in meshes experiment: 6 models x 4 orders x (7 pipelines + 2 hybrids x 3 force variants).
+TEST_F(SweepTest, MeshesExperimentCells) {
+  const Experiment x = load_experiment_by_name("meshes");
+  const auto all = cells(*parse_sweep(x.raw, "meshes"));
+  EXPECT_EQ(all.size(), 6u * 4u * 13u);
+  std::set<std::string> ids;
+  for (const auto& c : all) EXPECT_TRUE(ids.insert(c.id()).second) << c.id();
+  EXPECT_TRUE(fs::exists(x.scene.model.mesh.file)) << x.scene.model.mesh.file;
 }
 
 TEST_F(SweepTest, SlowCellsAreCutWithTheReason) {

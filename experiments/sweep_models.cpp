@@ -1,0 +1,93 @@
+#include "sweep_models.hpp"
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+#include "mesh/scene_model.hpp"
+
+namespace deformlab {
+
+using nlohmann::json;
+
+namespace {
+
+[[noreturn]] void bad(const std::string& where, const std::string& what) {
+  throw std::invalid_argument(where + ": " + what);
+}
+
+}  // namespace
+
+std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& where) {
+  if (!j.is_array() || j.empty()) bad(where, "expected a non-empty list of {\"name\": ..., \"model\": {...}}");
+  std::vector<SweepModel> out;
+  std::set<std::string> names;
+  for (std::size_t k = 0; k < j.size(); ++k) {
+    const std::string w = where + "[" + std::to_string(k) + "]";
+    const json& e = j[k];
+    if (!e.is_object() || e.size() != 2 || !e.contains("name") || !e.contains("model"))
+      bad(w, "expected {\"name\": ..., \"model\": {...}}");
+    const std::string name = e["name"].is_string() ? e["name"].get<std::string>() : "";
+    const bool safe = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.';
+    });
+    if (!safe) bad(w + ".name", "expected a name of letters, digits, '-', '_' and '.'");
+    if (!names.insert(name).second) bad(w + ".name", "model '" + name + "' is named twice");
+    Scene probe;
+    probe.model.topology = Topology::general;
+    apply_json(probe, {{"model", e["model"]}}, w);
+    if (probe.model.topology != Topology::general) bad(w + ".model.type", "sweep models are meshes (\"type\": \"mesh\")");
+    out.push_back({name, e["model"]});
+  }
+  return out;
+}
+
+std::vector<std::string> parse_sweep_orders(const json& j, const std::string& where) {
+  if (!j.is_array() || j.empty()) bad(where, std::string("expected a non-empty list of: ") + kNodeOrderNames);
+  std::vector<std::string> out;
+  for (const auto& o : j) {
+    if (!o.is_string() || !parse_node_order(o.get<std::string>()))
+      bad(where, std::string("expected a list of: ") + kNodeOrderNames);
+    if (std::find(out.begin(), out.end(), o.get<std::string>()) != out.end())
+      bad(where, "order '" + o.get<std::string>() + "' is named twice");
+    out.push_back(o.get<std::string>());
+  }
+  return out;
+}
+
+Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {
+  const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == c.model; });
+  Scene scene = x.scene;
+  scene.model.topology = Topology::general;
+  apply_json(scene, {{"model", m->model}}, "sweep.models." + c.model, x.dir);
+  if (!c.order.empty()) scene.model.mesh.order = *parse_node_order(c.order);
+  return scene;
+}
+
+const Model& ModelCache::model(const Scene& scene, const Cell& c) {
+  const std::string base = c.model.empty() ? "size " + std::to_string(c.size) : "model " + c.model;
+  const bool file_order = scene.model.topology != Topology::general || scene.model.mesh.order == NodeOrder::file;
+  const std::string order = file_order ? "file" : to_string(scene.model.mesh.order);
+  if (base != base_key_ || !base_) {
+    ordered_.reset();  // free the old ones before building the next
+    base_.reset();
+    base_key_.clear();
+    base_ = std::make_unique<Model>(build_model_in_file_order(scene));
+    base_key_ = base;
+    order_key_.clear();
+    ++bases_;
+  }
+  if (order != order_key_) {
+    ordered_.reset();
+    order_key_.clear();
+    if (!file_order) {
+      ordered_ = std::make_unique<Model>(*base_);
+      apply_node_order(*ordered_, scene.model);
+    }
+    order_key_ = order;
+    ++models_;
+  }
+  return file_order ? *base_ : *ordered_;
+}
+
+}  // namespace deformlab

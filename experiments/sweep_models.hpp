@@ -1,0 +1,23 @@
+// The mesh-model axes of a sweep (sweep.hpp): "models" and "orders", each model cell's scene
+// and the cache of built models.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "experiment.hpp"
+#include "sweep.hpp"
+
+namespace deformlab {
+
+// "models": [{"name": ..., "model": {...}}, ...]: names file-name safe and distinct, each model
+// a mesh model as a scene would read it (checked here, its files read when its cells run).
+std::vector<SweepModel> parse_sweep_models(const nlohmann::json& j, const std::string& where);
+// "orders": node order names, distinct.
+std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::string& where);
+
+// The experiment's scene with a model cell's model (relative files from the experiment's
+// folder) and order.
+Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c);
+
+}  // namespace deformlab

@@ -1,0 +1,42 @@
+// Gmsh through its API for the mesh loaders and generators (load.cpp, generate.cpp).
+#pragma once
+#include <gmsh.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "core/mesh_model.hpp"
+
+namespace deformlab {
+
+// Gmsh for the length of one task; its errors become exceptions with Gmsh's message.
+class GmshSession {
+ public:
+  GmshSession() {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.AbortOnError", 2);
+  }
+  ~GmshSession() { gmsh::finalize(); }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+  template <class F>
+  static void run(const std::string& what, F&& f) {
+    try {
+      f();
+    } catch (const std::invalid_argument&) {
+      throw;
+    } catch (...) {
+      std::string error;
+      gmsh::logger::getLastError(error);
+      throw std::invalid_argument(what + ": " + (error.empty() ? "Gmsh failed" : error));
+    }
+  }
+};
+
+// The current Gmsh model's linear tetrahedra or, if it has none, its triangles; `what` names
+// it in errors.
+Mesh read_gmsh_model(const std::string& what);
+
+}  // namespace deformlab
