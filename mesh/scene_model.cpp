@@ -20,21 +20,32 @@ void place(Mesh& m, const MeshSpec& s) {
 }
 
 // Refuses a mesh whose model would not fit beside what the host has left.
-void check_memory(const Mesh& mesh) {
+void check_memory(std::int64_t nodes, std::int64_t springs, std::int64_t elements) {
   const auto limit = host_memory_limit();
   if (!limit) return;
-  const std::int64_t need =
-      model_host_bytes({std::int64_t(mesh.position.size()), mesh_spring_bound(mesh), false}) +
-      std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()) * 64;  // sorting the elements' sides
+  const std::int64_t need = model_host_bytes({nodes, springs, false}) + elements * 64;  // sorting the elements' sides
   if (need > limit->bytes)
     throw std::invalid_argument("its model needs up to " + gib(need) + " of host memory; " +
                                 limit->name + " leaves " + gib(limit->bytes));
 }
+void check_memory(const Mesh& mesh) {
+  check_memory(std::int64_t(mesh.position.size()), mesh_spring_bound(mesh),
+               std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()));
+}
 
-// The mesh the spec names: read from its file or generated; what names it in errors.
+// The mesh the spec names: read from its file or generated (refused first when the model of
+// its estimated size would not fit: springs and elements a node as measured on Gmsh's meshes,
+// sheets 6.0 and 2.0, boxes 14.8 and 6.0, with a margin); what names it in errors.
 Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
   if (ms.generate) {
     what = "generated " + std::string(to_string(ms.generate->kind));
+    const bool sheet = ms.generate->kind == MeshShape::Kind::sheet;
+    const double n = estimated_nodes(*ms.generate);
+    try {
+      check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(what + " of about " + std::to_string(std::int64_t(n)) + " nodes: " + e.what());
+    }
     return generate_mesh(*ms.generate);
   }
   if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file) or a shape (model.generate)");
