@@ -157,9 +157,9 @@ const std::vector<BadInput>& cases() {
       scene("generate_cell_zero", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0})"),
             "s.json.model.generate.cell_size: expected a number > 0"),
       scene("generate_no_cell", G(R"({"shape": "sheet", "size": [1, 1]})"), "s.json.model.generate: needs cell_size"),
-      // about 180 M nodes: under the node limit, over any host's memory (some 180 GB), refused before meshing
-      scene("generate_over_memory", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.0015})"),
-            "generated box of about 180316439 nodes: its model needs up to"),
+      // about 985 M nodes: under the node limit, over any host's memory (some 950 GiB), refused before meshing
+      scene("generate_over_memory", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.00085})"),
+            "generated box of about 984905639 nodes: its model needs up to"),
       scene("generate_key", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1, "algo": 5})"),
             "s.json.model.generate.algo: unknown key"),
       scene("generate_too_many_nodes", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.0001})"),
