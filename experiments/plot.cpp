@@ -32,9 +32,10 @@ std::string num(double v) {
   return os.str();
 }
 
-void save(const std::filesystem::path& file, const std::string& body) {
+// The SVG of `body`, kW wide and `height` high (kH, or more where labels hang below the plot).
+void save(const std::filesystem::path& file, const std::string& body, double height = kH) {
   std::ofstream out(file);
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << kH
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << height
       << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << body << "</svg>\n";
   if (!out) throw std::runtime_error("cannot write " + file.string());
@@ -118,6 +119,12 @@ void stacked_bars(const std::filesystem::path& file, const std::string& title, c
   }
   const double plot_w = kW - kLeft - kRight, plot_h = kH - kTop - kBottom;
   const double slot = plot_w / double(bars.size()), bw = slot * 0.6;
+  // Category labels under their bars, or, where they would overlap, turned to run downwards
+  // (the picture grows to hold them).
+  std::size_t longest = 0;
+  for (const auto& s : bars) longest = std::max(longest, s.category.size());
+  const bool turned = double(longest) * 7 > slot;
+  const double height = turned ? kH - kBottom + 12 + double(longest) * 6.5 : kH;
   auto py = [&](double v) { return kH - kBottom - v / top * plot_h; };
   for (int t = 0; t <= 4; ++t) {
     const double v = top * t / 4;
@@ -134,8 +141,12 @@ void stacked_bars(const std::filesystem::path& file, const std::string& title, c
         << py(base) - py(base + v) << "\" fill=\"" << kColors[k % std::size(kColors)] << "\"/>\n";
       base += v;
     }
-    b << "<text x=\"" << x + bw / 2 << "\" y=\"" << kH - kBottom + 16 << "\" text-anchor=\"middle\">"
-      << esc(bars[i].category) << "</text>\n";
+    if (turned)
+      b << "<text transform=\"translate(" << x + bw / 2 + 4 << "," << kH - kBottom + 8
+        << ") rotate(-90)\" text-anchor=\"end\" font-size=\"11\">" << esc(bars[i].category) << "</text>\n";
+    else
+      b << "<text x=\"" << x + bw / 2 << "\" y=\"" << kH - kBottom + 16 << "\" text-anchor=\"middle\">"
+        << esc(bars[i].category) << "</text>\n";
   }
   for (std::size_t k = 0; k < part_names.size(); ++k) {
     const double ly = kTop + 14 + 18 * double(k);
@@ -143,7 +154,7 @@ void stacked_bars(const std::filesystem::path& file, const std::string& title, c
       << kColors[k % std::size(kColors)] << "\"/><text x=\"" << kW - kRight + 30 << "\" y=\"" << ly << "\">"
       << esc(part_names[k]) << "</text>\n";
   }
-  save(file, b.str());
+  save(file, b.str(), height);
 }
 
 }  // namespace deformlab::plot
