@@ -71,7 +71,9 @@ TEST(GeneratedMesh, TakesTheSamePathAsAFile) {
   int pinned = 0;
   for (int v = 0; v < m.node_count(); ++v) {
     pinned += m.pinned(v);
-    if (m.pinned(v)) EXPECT_LE(m.rest_position[v].y, 0.5f + 1e-6f);
+    if (m.pinned(v)) {
+      EXPECT_LE(m.rest_position[v].y, 0.5f + 1e-6f);
+    }
     EXPECT_GE(m.rest_position[v].y, 0.45f - 1e-6f);
   }
   EXPECT_GT(pinned, 0);
