@@ -69,7 +69,9 @@ TEST_P(LiveChanges, DragHandleReplacedBetweenStepsAsOnCpu) {
   for (std::size_t phase = 0; phase < g.size(); ++phase) {
     SCOPED_TRACE("phase " + std::to_string(phase));
     EXPECT_EQ(g[phase].t, a[phase].t);
-    if (phase == 1) EXPECT_EQ(g[phase].x[moved], h[1].target(g[phase].t)) << "hard handles are exact on every pipeline";
+    if (phase == 1) {
+      EXPECT_EQ(g[phase].x[moved], h[1].target(g[phase].t)) << "hard handles are exact on every pipeline";
+    }
     if (e.traits.cpu_match == CpuMatch::bitwise) {
       EXPECT_TRUE(bitwise_equal(g[phase], a[phase])) << "|x - x_cpu| = " << max_position_diff(g[phase], a[phase]);
       continue;
