@@ -67,6 +67,21 @@ const json* facts(const ModelResults& res, const Sweep& s, const std::string& mo
 }
 
 // A ratio of two measured times, or "-".
+// A table's header: `first`, then a column per name, and the separator row.
+void header(std::ostringstream& md, const std::string& first, const std::vector<std::string>& columns) {
+  md << "| " << first << " |";
+  for (const auto& c : columns) md << " " << c << " |";
+  md << "\n|---|";
+  for (std::size_t k = 0; k < columns.size(); ++k) md << "---|";
+}
+
+// The order columns' names ("" is the model's own order).
+std::vector<std::string> order_names(const std::vector<std::string>& orders) {
+  std::vector<std::string> out;
+  for (const auto& o : orders) out.push_back(o.empty() ? "own order" : o);
+  return out;
+}
+
 std::string ratio(std::optional<double> a, std::optional<double> b) { return a && b ? fmt(*a / *b) : "-"; }
 
 // The largest and smallest of `ratios` (label, value) as "r (label)" phrases.
@@ -103,10 +118,7 @@ void write_times(std::ostringstream& md, ModelTable& t, const json* f) {
     if (floor_ms) md << "; the floor, those bytes at the CUDA copy bandwidth (" << fmt(t.ceil.copy_gb_s) << " GB/s): " << fmt(*floor_ms) << " ms";
     md << ".\n\n";
   }
-  md << "| pipeline |";
-  for (const auto& o : orders) md << " " << (o.empty() ? "own order" : o) << " |";
-  md << "\n|---|";
-  for (std::size_t k = 0; k < orders.size(); ++k) md << "---|";
+  header(md, "pipeline", order_names(orders));
   md << "\n| bandwidth |";
   for (const auto& o : orders) {
     const json* c = nullptr;
@@ -139,13 +151,11 @@ void write_times(std::ostringstream& md, ModelTable& t, const json* f) {
 void write_order_ratios(std::ostringstream& md, ModelTable& t) {
   const auto& orders = t.sweep.orders;
   if (std::find(orders.begin(), orders.end(), "file") == orders.end() || orders.size() < 2) return;
-  md << "Node order against the file's (time / file-order time):\n\n| pipeline |";
-  std::vector<std::string> others;
+  md << "Node order against the file's (time / file-order time):\n\n";
+  std::vector<std::string> others, titles;
   for (const auto& o : orders)
-    if (o != "file") others.push_back(o);
-  for (const auto& o : others) md << " " << o << " / file |";
-  md << "\n|---|";
-  for (std::size_t k = 0; k < others.size(); ++k) md << "---|";
+    if (o != "file") others.push_back(o), titles.push_back(o + " / file");
+  header(md, "pipeline", titles);
   md << "\n";
   std::map<std::string, std::vector<std::pair<std::string, double>>> by_order;
   for (const auto& r : t.rows) {
@@ -187,10 +197,8 @@ void write_variant_ratios(std::ostringstream& md, ModelTable& t) {
   }
   if (pairs.empty()) return;
   const auto orders = orders_of(t.sweep);
-  md << "Force variants and hybrids (time / time; below 1 the first is faster):\n\n| ratio |";
-  for (const auto& o : orders) md << " " << (o.empty() ? "own order" : o) << " |";
-  md << "\n|---|";
-  for (std::size_t k = 0; k < orders.size(); ++k) md << "---|";
+  md << "Force variants and hybrids (time / time; below 1 the first is faster):\n\n";
+  header(md, "ratio", order_names(orders));
   md << "\n";
   for (const auto& p : pairs) {
     md << "| " << p.num << " / " << p.den << " |";
