@@ -14,6 +14,19 @@ std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
   return t.take();
 }
 
+const char* to_string(Math m) { return m == Math::fast ? "fast" : "exact"; }
+
+Math math_option(const PipelineOptions& o) {
+  const auto it = o.find("math");
+  if (it == o.end() || it->second == "exact") return Math::exact;
+  if (it->second == "fast") return Math::fast;
+  throw std::invalid_argument("option math '" + it->second + "' is not exact or fast");
+}
+
+CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o) {
+  return math_option(o) == Math::fast ? CpuMatch::rounding : e.traits.cpu_match;
+}
+
 void PipelineRegistry::add(PipelineEntry e) {
   if (find(e.name)) throw std::logic_error("pipeline registered twice: " + e.name);
   entries_.push_back(std::move(e));

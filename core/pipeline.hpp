@@ -47,6 +47,16 @@ class Pipeline {
 // pipeline lists the names it reads in its registry entry (PipelineEntry::options).
 using PipelineOptions = std::map<std::string, std::string>;
 
+// How a GPU pipeline's kernels and shaders do their float arithmetic (the pipeline option
+// "math", the precision option): `exact` does the CPU float pipeline's operations (no
+// contraction into fused multiply-adds, correctly rounded division and square root); `fast`
+// lets the compiler contract and use the hardware's approximate reciprocal and reciprocal
+// square root (nvcc's fast math, GLSL's defaults). Exact is the default (README: why).
+enum class Math { exact, fast };
+const char* to_string(Math m);
+// The option "math" ("exact" or "fast"), else exact; throws std::invalid_argument.
+Math math_option(const PipelineOptions& o);
+
 // What a pipeline needs to be built.
 struct PipelineSetup {
   const Model& model;
@@ -67,7 +77,7 @@ enum class CpuMatch { bitwise, rounding };
 struct PipelineTraits {
   Engine force = Engine::cpu, update = Engine::cpu;
   bool deterministic = true;  // bitwise equal run to run
-  CpuMatch cpu_match = CpuMatch::bitwise;
+  CpuMatch cpu_match = CpuMatch::bitwise;  // with exact math (fast math: rounding)
   // Its passes run on two APIs, which hand the state over twice per force evaluation.
   bool hands_off() const { return force != update; }
   bool operator==(const PipelineTraits&) const = default;
@@ -87,6 +97,10 @@ struct PipelineEntry {
   // its device (checked against the device's free memory when it is built).
   std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint = {};
 };
+
+// How `e` run with options `o` compares with the `cpu` pipeline: its trait, or rounding
+// where the options choose fast math.
+CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o);
 
 // Empty when a run of `e` on a model of size `m` fits in this machine's host memory, else one
 // line naming the need (the model, the pipeline's own host buffers, a state read back; with a
