@@ -1,5 +1,6 @@
 // `deformlab-bench cuda`: ms per step of the CUDA pipelines on cloth grids, against the
-// device's own copy bandwidth; launch overhead with and without step graphs; tile shapes.
+// device's own copy bandwidth; launch overhead with and without step graphs; tile shapes;
+// cuda-fused in exact and fast math; cuda-temporal's steps per launch.
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
@@ -24,31 +25,35 @@ struct CudaOptions : BenchOptions {
   int batches = 15;
   int copy_mib = 1024;
   double reference_ms = 0.48;
+  std::vector<int> temporal_sizes{2048, 8192};
+  std::vector<int> steps_per_launch{1, 2, 4, 8};
 };
 
 cuda::Variant parse_variant(const std::string& s) {
-  for (cuda::Variant v : {cuda::Variant::naive, cuda::Variant::tiled, cuda::Variant::scatter, cuda::Variant::fused})
+  for (cuda::Variant v : {cuda::Variant::naive, cuda::Variant::tiled, cuda::Variant::scatter, cuda::Variant::fused,
+                          cuda::Variant::temporal})
     if (s == cuda::to_string(v)) return v;
-  throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused)");
+  throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused, temporal)");
 }
 
 double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
 
 // Median ms per step from the rest state: warm-up steps, then `batches` batches of steps
-// (each about a millisecond: 3 to 100 steps), a batch's figure the mean of its steps, each
-// step between CUDA events (the pipeline's step clock).
+// (each about a millisecond: 8 to 104 steps, a multiple of 8 so that cuda-temporal's launches
+// are whole), a batch's figure the mean of its steps, each step on the pipeline's step clock
+// (CUDA events).
 Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, int warmup, int batches) {
   p.set_state(rest_state(m));
   const auto timer = p.step_timer();
   const double warm = mean(timed_steps(p, *timer, warmup));
-  const int steps = std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100);
+  const int steps = (std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100) + 7) / 8 * 8;
   std::vector<double> ms;
   for (int b = 0; b < batches; ++b) ms.push_back(mean(timed_steps(p, *timer, steps)));
   return stats(ms);
 }
 
 struct Row {
-  std::string table, scene, grid, variant, integrator, tile;
+  std::string table, scene, grid, variant, integrator, tile, math;
   bool graphs;
   std::int64_t nodes;
   double ms, floor_bytes, gbs, of_copy;
@@ -58,8 +63,8 @@ class Report {
  public:
   Report(const CudaOptions& o, double copy_gbs)
       : copy_gbs_(copy_gbs),
-        csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,graphs,median_ms,floor_bytes_per_node,"
-                             "effective_GBps,fraction_of_copy")) {}
+        csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
+                             "floor_bytes_per_node,effective_GBps,fraction_of_copy")) {}
   Row measure(const std::string& table, SceneKind kind, const BenchScene& scene, Integrator integ,
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
@@ -72,15 +77,17 @@ class Report {
     r.variant = cuda::to_string(opt.variant);
     r.integrator = std::string(info(integ).name);
     r.tile = std::to_string(opt.tile.x) + "x" + std::to_string(opt.tile.y);
+    r.math = to_string(opt.math);
+    const int k = opt.variant == cuda::Variant::temporal ? cuda::steps_per_launch(m, opt) : 1;
     r.graphs = opt.graphs;
     r.nodes = m.node_count();
     r.ms = st.median;
-    r.floor_bytes = cuda::floor_bytes_per_node(m, integ, opt.variant);
+    r.floor_bytes = cuda::floor_bytes_per_node(m, integ, opt);
     r.gbs = r.floor_bytes * double(r.nodes) / (r.ms * 1e-3) / 1e9;
     r.of_copy = r.gbs / copy_gbs_;
     if (csv_)
       csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator << "," << r.tile
-           << "," << r.graphs << "," << r.ms << "," << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
+           << "," << r.math << "," << k << "," << r.graphs << "," << r.ms << "," << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
     return r;
   }
 
@@ -159,18 +166,45 @@ void run_cuda(const CudaOptions& o) {
   }
 
   if (o.tile_size > 0) {
-    std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 against the copy ceiling and the "
-              << "paper author's CUDA Verlet cloth kernel (" << o.reference_ms << " ms per step at 2048^2 on this "
-              << "machine type)\n"
-              << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step" << std::setw(10)
-              << "B/node" << std::setw(10) << "of copy" << std::setw(14) << "vs reference" << "\n";
+    std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
+              << "ceiling and the paper author's CUDA Verlet cloth kernel (" << o.reference_ms << " ms per step at "
+              << "2048^2 on this machine type)\n"
+              << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(12)
+              << "ms/step" << std::setw(10) << "B/node" << std::setw(10) << "of copy" << std::setw(14) << "vs reference"
+              << "\n";
     for (SceneKind k : {SceneKind::paper, SceneKind::idealised})
-    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet}) {
-      const BenchScene scene(o.tile_size, k);
-      const Row r = rep.measure("fused", k, scene, i, {cuda::Variant::fused, {}, true}, o);
-      std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4) << std::setw(10)
-                << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%" << std::setw(13)
-                << fixed(o.reference_ms / r.ms, 2) << "x\n";
+      for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet})
+        for (Math math : {Math::exact, Math::fast}) {
+          const BenchScene scene(o.tile_size, k);
+          const Row r = rep.measure("fused", k, scene, i, {cuda::Variant::fused, {}, true, math}, o);
+          std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(7) << r.math
+                    << std::setw(12) << fixed(r.ms, 4) << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(9)
+                    << fixed(100 * r.of_copy, 1) << "%" << std::setw(13) << fixed(o.reference_ms / r.ms, 2) << "x\n";
+        }
+  }
+
+  if (!o.temporal_sizes.empty()) {
+    std::cout << "\n[temporal] cuda-temporal on the " << to_string(kind) << " scene, steps per launch k (default "
+              << "tile: the largest square with its 2k-node halo in shared memory), against cuda-fused of the same "
+              << "math and the one-step roofline (64 B per node and step at the copy bandwidth)\n"
+              << std::setw(8) << "grid" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(4)
+              << "k" << std::setw(12) << "ms/step" << std::setw(12) << "fused" << std::setw(12) << "roofline"
+              << std::setw(14) << "vs roofline" << "\n";
+    for (int n : o.temporal_sizes) {
+      const BenchScene scene(n, kind);
+      const double roofline = 64.0 * double(scene.model.node_count()) / (copy_gbs * 1e9) * 1e3;
+      for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet})
+        for (Math math : {Math::exact, Math::fast}) {
+          const double fused = rep.measure("temporal", kind, scene, i, {cuda::Variant::fused, {}, true, math}, o).ms;
+          for (int k : o.steps_per_launch) {
+            cuda::Options t{cuda::Variant::temporal, {}, true, math};
+            t.steps_per_launch = k;
+            const Row r = rep.measure("temporal", kind, scene, i, t, o);
+            std::cout << std::setw(8) << r.grid << std::setw(22) << r.integrator << std::setw(7) << r.math
+                      << std::setw(4) << k << std::setw(12) << fixed(r.ms, 4) << std::setw(12) << fixed(fused, 4)
+                      << std::setw(12) << fixed(roofline, 4) << std::setw(13) << fixed(roofline / r.ms, 2) << "x\n";
+          }
+        }
     }
   }
 }
@@ -185,7 +219,7 @@ void add_cuda_bench(CLI::App& app) {
   auto* c = app.add_subcommand("cuda", "CUDA variants: ms/step at 64^2 to 8192^2 against the copy bandwidth, "
                                        "step graphs, tile sweep");
   add_bench_options(*c, *o);
-  c->add_option("--variants", o->variants, "Variants: naive, tiled, scatter, fused");
+  c->add_option("--variants", o->variants, "Variants: naive, tiled, scatter, fused, temporal");
   c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
@@ -193,6 +227,9 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
       ->check(CLI::PositiveNumber);
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
+  c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none: skip)");
+  c->add_option("--steps-per-launch", o->steps_per_launch, "cuda-temporal's steps per launch to compare")
+      ->check(CLI::Range(1, 8));
   c->callback([o] { run_cuda(*o); });
 }
 

@@ -78,6 +78,7 @@ struct PipelineTraits {
   Engine force = Engine::cpu, update = Engine::cpu;
   bool deterministic = true;  // bitwise equal run to run
   CpuMatch cpu_match = CpuMatch::bitwise;  // with exact math (fast math: rounding)
+  bool grids_only = false;  // runs cloth and lattice grids, not general models (meshes)
   // Its passes run on two APIs, which hand the state over twice per force evaluation.
   bool hands_off() const { return force != update; }
   bool operator==(const PipelineTraits&) const = default;

@@ -1,6 +1,7 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
 // and the device reductions (displacement, energy); and its force pass on its own, the CUDA
-// stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels.
+// stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels. It is
+// compiled once per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
 #include <cub/device/device_reduce.cuh>
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
@@ -8,6 +9,7 @@
 #include <thrust/transform_reduce.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -24,9 +26,12 @@
 #include "core/partition.hpp"
 #include "core/stage.hpp"
 #include "core/step_params.hpp"
+#include "fused_cloth.cuh"
 #include "kernels.cuh"
+#include "temporal.cuh"
+#include "math_builds.hpp"
 
-namespace deformlab::cuda {
+namespace deformlab::cuda::DL_CUDA_MATH {
 namespace {
 
 using dev::Link;
@@ -254,10 +259,13 @@ struct GridSpringEnergyOp {
 // after a take): a step's time runs from the end of the step before to its own, as the device
 // ran them, idle time between them included. A pair of events around each step would instead
 // add the device's launch latency to every step replayed from a graph (10 us of 130 at 2048^2
-// on the H100).
+// on the H100). cuda-temporal queues k steps in one launch: an event then ends k steps, each
+// timed as 1/k of the interval (`launched` counts the steps queued on the device; `flush`
+// queues those still held back).
 class EventStepTimer final : public StepTimer {
  public:
-  explicit EventStepTimer(cudaStream_t s) : s_(s) {}
+  EventStepTimer(cudaStream_t s, const std::int64_t* launched, std::function<void()> flush)
+      : s_(s), launched_(launched), flush_(std::move(flush)) {}
   ~EventStepTimer() override {
     for (cudaEvent_t e : events_) cudaEventDestroy(e);
   }
@@ -265,10 +273,13 @@ class EventStepTimer final : public StepTimer {
     if (marks_ == 0) mark();
   }
   void end() override {
+    if (*launched_ == last_) return;
     mark();
     if (marks_ > 4096) resolve();
   }
   std::vector<double> take() override {
+    flush_();
+    end();
     resolve();
     marks_ = 0;
     return std::exchange(done_, {});
@@ -281,7 +292,10 @@ class EventStepTimer final : public StepTimer {
       cudaEvent_t e = nullptr;
       check(cudaEventCreate(&e), "creating a timing event");
       events_.push_back(e);
+      steps_.push_back(0);
     }
+    steps_[marks_] = int(*launched_ - last_);
+    last_ = *launched_;
     check(cudaEventRecord(events_[marks_++], s_), "recording a step's end");
   }
   // The steps marked so far into done_; the last mark stays as the next step's start.
@@ -291,13 +305,17 @@ class EventStepTimer final : public StepTimer {
     for (std::size_t k = 1; k < marks_; ++k) {
       float ms = 0.f;
       check(cudaEventElapsedTime(&ms, events_[k - 1], events_[k]), "reading the step timer");
-      done_.push_back(double(ms));
+      done_.insert(done_.end(), steps_[k], double(ms) / steps_[k]);
     }
     std::swap(events_[0], events_[marks_ - 1]);
     marks_ = 1;
   }
   cudaStream_t s_;
+  const std::int64_t* launched_;
+  std::int64_t last_ = 0;  // *launched_ at the last mark
+  std::function<void()> flush_;
   std::vector<cudaEvent_t> events_;
+  std::vector<int> steps_;  // steps ended by each event
   std::size_t marks_ = 0;  // events recorded since the last resolve
   std::vector<double> done_;
 };
@@ -309,6 +327,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const Model& m = model_;
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
+    if (o_.variant == Variant::temporal) plan_temporal();
+    if (fused_ && m.grid() && !m.volume()) {
+      check_fused_cloth_tile();
+      ForceKernels::upload(halo_, halo_springs(o_.tile), "uploading the halo's springs");
+    }
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
@@ -318,9 +341,12 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       sx_[k].allocate(n_, "allocating stage positions");
       sv_[k].allocate(n_, "allocating stage velocities");
     }
-    if (!fused_)
+    if (!fused_ && !temporal_)
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
-    warp_max_.allocate(std::max(warps_of(dim3(blocks_for(n_)), dim3(kBlock)), warps_of(grid_blocks(), grid_threads())),
+    if (temporal_ && sched_.rule == UpdateRule::verlet)
+      for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
+    warp_max_.allocate(std::max({warps_of(dim3(blocks_for(n_)), dim3(kBlock)), warps_of(grid_blocks(), grid_threads()),
+                                 temporal_ ? warps_of(temporal_blocks(), dim3(dev::kTemporalThreads)) : 0}),
                        "allocating the stop rule's warp maxima");
     stop_max_.allocate(1, "allocating the largest displacement");
     std::size_t bytes = 0;
@@ -342,24 +368,27 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
         (!s.x_prev.empty() && s.x_prev.size() != std::size_t(n_)))
       throw std::invalid_argument("state size does not match the model");
     cur_ = 0;
+    pending_ = 0;
     upload_positions(x_[0], s.x);
     upload_vectors(v_[0], s.v);
     has_prev_ = !s.x_prev.empty();
-    if (has_prev_) upload_positions(x_[1], s.x_prev);
+    if (has_prev_) upload_positions(prev_x(0), s.x_prev);
     t_ = s.t;
     stepped_ = false;
   }
 
   State state() override {
+    flush();
     State s;
     s.t = t_;
     s.x = download(x_[cur_]);
     s.v = download(v_[cur_]);
-    if (sched_.rule == UpdateRule::verlet && has_prev_) s.x_prev = download(x_[1 - cur_]);
+    if (sched_.rule == UpdateRule::verlet && has_prev_) s.x_prev = download(prev_x(cur_));
     return s;
   }
 
   void copy_positions(float4* dst, cudaStream_t stream) override {
+    flush();
     if (!copied_) check(cudaEventCreateWithFlags(&copied_, cudaEventDisableTiming), "creating the copy event");
     check(cudaEventRecord(copied_, stream_), "marking the step before a copy");
     check(cudaStreamWaitEvent(stream, copied_, 0), "ordering a copy after the step");
@@ -369,12 +398,14 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
 
   void set_drag(const DragHandle& d) override {
     validate(d, n_);
+    flush();  // the steps held back ran with the old handle
     p_.drag = d;
     set_drag_params<float>(sp_, d);
     drop_graphs();  // their launches carry the old handle
   }
 
   void step() override {
+    if (temporal_) return hold_step();
     // Profiled steps run pass by pass (a graph replay has no spans).
     const bool replay = !prof_ && o_.graphs && time_invariant() && !(sched_.rule == UpdateRule::verlet && !has_prev_);
     if (replay) {
@@ -387,11 +418,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     cur_ = 1 - cur_;
     t_ += p_.dt;
     stepped_ = true;
+    ++launched_;
   }
 
   // The largest of the last step's warp maxima (dev::StopCheck): one small reduction and a
   // word read back.
   double max_displacement() override {
+    flush();
     if (!stepped_) return 0.0;
     std::size_t bytes = reduce_temp_.size();
     check(cub::DeviceReduce::Max(reduce_temp_.get(), bytes, warp_max_.get(), stop_max_.get(), stop_warps_, stream_),
@@ -406,6 +439,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   Energy energy() override {
+    flush();
     if (!model_.grid() && !springs_.get() && model_.spring_count() > 0) upload_springs();
     const auto policy = thrust::cuda::par.on(stream_);
     const NodeEnergy ne = thrust::transform_reduce(
@@ -434,7 +468,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     prof_ = p;
   }
 
-  std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<EventStepTimer>(stream_); }
+  std::unique_ptr<StepTimer> step_timer() override {
+    return std::make_unique<EventStepTimer>(stream_, &launched_, [this] { flush(); });
+  }
 
  private:
   // State transfers go through the pipeline's stream (ordered after the steps already queued)
@@ -548,9 +584,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
 
   // The checks in the order their errors are reported, before anything is allocated.
   static const Model& checked(const PipelineSetup& su, const Options& o) {
-    if (const std::string why = unsupported(su.integrator); !why.empty()) throw std::invalid_argument(why);
+    if (const std::string why = unsupported(su.integrator, o.variant); !why.empty()) throw std::invalid_argument(why);
     if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
     validate(su.params, su.model.node_count());
+    if (o.variant == Variant::temporal && !su.model.grid())
+      throw std::invalid_argument("cuda-temporal runs grid models (cloths and lattices), not meshes (use cuda-fused)");
     if (o.variant == Variant::tiled || su.model.topology != Topology::general) check_tile(su.model, o.tile);
     require_device_memory(bytes_needed(su.model.size(), su.integrator, o),
                           std::string("the cuda-") + to_string(o.variant) + " pipeline for " +
@@ -585,6 +623,18 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
                                                                    has_prev_, xo, vo, tg,
                                                                    stop_check(blocks_for(n_), kBlock));
       check_launch("launching the fused CSR step kernel");
+    } else if (!model_.volume()) {
+      with_grid_flags([&](auto, auto damped) {
+        const auto kernel = dev::fused_cloth<damped(), Rule>;
+        const std::size_t shared = fused_cloth_shared();
+        if (shared > 48 * 1024)
+          check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
+                "raising the fused kernel's shared-memory limit");
+        const dev::HaloSprings halo{halo_.get(), int(halo_.size())};
+        kernel<<<grid_blocks(), grid_threads(), shared, stream_>>>(sp_, stencil_, w, halo, x, v, xp, has_prev_, xo, vo,
+                                                                   tg, stop_check(grid_blocks(), grid_threads()));
+      });
+      check_launch("launching the fused cloth step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
@@ -593,6 +643,126 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       });
       check_launch("launching the fused step kernel");
     }
+  }
+
+  // The springs of a tile's halo that reach into it (dev::HaloSprings): own entry e of halo
+  // cell (a, b) whose other end is in the tile.
+  static std::vector<int> halo_springs(const Tile& t) {
+    std::vector<int> out;
+    for (int e = 0; e < dev::kOwnSprings; ++e) {
+      const GridOffset o = grid_offset(false, dev::kOwnSprings + e);
+      for (int b = -dev::kHalo; b < t.y; ++b)
+        for (int a = -dev::kHalo; a <= t.x; ++a) {
+          const bool in = a >= 0 && a < t.x && b >= 0 && b < t.y;
+          const int fa = a + o.di, fb = b + o.dj;
+          if (!in && fa >= 0 && fa < t.x && fb >= 0 && fb < t.y) out.push_back(e | (a + 2) << 3 | (b + 2) << 15);
+        }
+    }
+    return out;
+  }
+  // cuda-fused on a cloth (dev::fused_cloth): the block's state with its halo and the force cells.
+  std::size_t fused_cloth_shared() const {
+    const int tx = o_.tile.x, ty = o_.tile.y;
+    return sizeof(float4) * (std::size_t(tx + 2 * dev::kHalo) * (ty + 2 * dev::kHalo) * (damped_ ? 2 : 1) +
+                             std::size_t(dev::kOwnSprings) * (tx + 3) * (ty + 2));
+  }
+  void check_fused_cloth_tile() const {
+    int device = 0, limit = 0;
+    check(cudaGetDevice(&device), "finding the device");
+    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
+          "reading the shared-memory limit");
+    if (fused_cloth_shared() > std::size_t(limit))
+      throw std::invalid_argument("cuda-fused: a tile of " + std::to_string(o_.tile.x) + "x" +
+                                  std::to_string(o_.tile.y) + " needs " + std::to_string(fused_cloth_shared()) +
+                                  " bytes of shared memory on a cloth; this device allows " + std::to_string(limit) +
+                                  " a block (choose a smaller tile)");
+  }
+
+  // Verlet's previous positions of state c: the other ping-pong buffer, or (cuda-temporal,
+  // whose launches read a tile's halo from it while others write) a pair of their own.
+  Buffer<float4>& prev_x(int c) { return temporal_ && sched_.rule == UpdateRule::verlet ? prev_[c] : x_[1 - c]; }
+
+  // cuda-temporal's checks and launch shape: grids only; the tile's region (the tile and a
+  // halo of 2k nodes, two copies of x and v a cell) within the device's shared memory.
+  void plan_temporal() {
+    const Model& m = model_;
+    temporal_ = true;
+    k_ = steps_per_launch(m, o_);
+    const int halo = 2 * k_;
+    const bool volume = m.volume();
+    const std::size_t cell = 4 * sizeof(float4);
+    int device = 0, limit = 0;
+    check(cudaGetDevice(&device), "finding the device");
+    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
+          "reading the shared-memory limit");
+    TemporalTile t = o_.temporal_tile;
+    if (t.x == 0) {  // the largest square or cube
+      const int side = int(std::pow(double(std::size_t(limit) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
+      t = {side, side, volume ? side : 1};
+    }
+    if (!volume) t.z = 1;
+    if (t.z == 0) t.z = t.y;
+    const std::int64_t cells = std::int64_t(t.x + 2 * halo) * (t.y + 2 * halo) * (volume ? t.z + 2 * halo : 1);
+    temporal_shared_ = std::size_t(cells) * cell;
+    if (t.x < 1 || temporal_shared_ > std::size_t(limit))
+      throw std::invalid_argument(
+          "cuda-temporal: " + std::to_string(k_) + " steps a launch need a halo of " +
+          std::to_string(halo) + " nodes around each tile; " +
+          (t.x < 1 ? std::string("no tile") : "a tile of " + std::to_string(t.x) + "x" + std::to_string(t.y) +
+                                                   (volume ? "x" + std::to_string(t.z) : "") + " nodes") +
+          " with it " + (t.x < 1 ? "fits in " : "needs " + std::to_string(temporal_shared_) + " bytes of ") +
+          "shared memory" + (t.x < 1 ? "" : ",") + " where this device allows " + std::to_string(limit) +
+          " a block (choose fewer steps_per_launch" + (t.x < 1 ? "" : " or a smaller tile") + ")");
+    temporal_tile_ = int3{t.x, t.y, t.z};
+    if (temporal_blocks().y > 65535 || temporal_blocks().z > 65535)
+      throw std::invalid_argument("cuda-temporal: the grid exceeds the CUDA launch limits with this tile");
+  }
+  dim3 temporal_blocks() const {
+    const int3 t = temporal_tile_;
+    return dim3(unsigned((sp_.nx + t.x - 1) / t.x), unsigned((sp_.ny + t.y - 1) / t.y), unsigned((sp_.nz + t.z - 1) / t.z));
+  }
+
+  // cuda-temporal's step: held until steps_per_launch steps can go in one launch.
+  void hold_step() {
+    held_t_[pending_++] = t_;
+    t_ += p_.dt;
+    stepped_ = true;
+    if (pending_ == k_) flush();
+  }
+  // Launches the held steps, if any (before anything reads the state or its step times).
+  void flush() {
+    if (pending_ == 0) return;
+    timed(span::force_update, [&] {
+      switch (sched_.rule) {
+        case UpdateRule::runge_kutta: return launch_temporal<RULE_RUNGE_KUTTA>();
+        case UpdateRule::semi_implicit_euler: return launch_temporal<RULE_SEMI_IMPLICIT_EULER>();
+        case UpdateRule::verlet: return launch_temporal<RULE_VERLET>();
+        case UpdateRule::backward_euler: throw std::logic_error("cuda-temporal step for backward Euler");
+      }
+    });
+    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
+    cur_ = 1 - cur_;
+    launched_ += pending_;
+    pending_ = 0;
+  }
+  template <int Rule>
+  void launch_temporal() {
+    dev::StepTargets tg{};
+    for (int q = 0; q < pending_ && p_.drag.active(); ++q)
+      tg.step[q] = {p_.drag.target(held_t_[q]), p_.drag.target(held_t_[q] + p_.dt)};
+    const int nxt = 1 - cur_;
+    const bool verlet = Rule == RULE_VERLET;
+    const dim3 blocks = temporal_blocks(), threads(dev::kTemporalThreads);
+    with_grid_flags([&](auto n, auto damped) {
+      const auto kernel = dev::temporal_grid<n(), damped(), Rule>;
+      check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(temporal_shared_)),
+            "raising the temporal kernel's shared-memory limit");
+      kernel<<<blocks, threads, temporal_shared_, stream_>>>(
+          sp_, stencil_, float(sched_.weight()), pending_, temporal_tile_, x_[cur_].get(), v_[cur_].get(),
+          verlet ? prev_[cur_].get() : nullptr, has_prev_, x_[nxt].get(), v_[nxt].get(),
+          verlet ? prev_[nxt].get() : nullptr, tg, stop_check(blocks, threads));
+    });
+    check_launch("launching the temporal step kernel");
   }
 
   static std::int64_t warps_of(dim3 blocks, dim3 threads) {
@@ -634,6 +804,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
+  Buffer<float4> prev_[2];
+  Buffer<int> halo_;  // cuda-fused on cloths: the tile's halo springs (dev::HaloSprings)  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
   Buffer<unsigned> warp_max_, stop_max_;  // the stop rule's warp maxima (dev::StopCheck), their largest
   Buffer<unsigned char> reduce_temp_;
   std::int64_t stop_warps_ = 0;  // of the last step's launch
@@ -648,6 +820,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
+  std::int64_t launched_ = 0;  // steps queued on the device
+
+  // cuda-temporal: steps are held back until a launch can take steps_per_launch of them (or
+  // something reads the state); t_ then counts the held steps too.
+  bool temporal_ = false;
+  int k_ = 1, pending_ = 0;  // steps a launch, steps held
+  int3 temporal_tile_{};
+  double held_t_[dev::kMaxStepsPerLaunch] = {};  // the held steps' start times
+  std::size_t temporal_shared_ = 0;
 };
 
 // The force pass alone, on the current device (the hybrid pipelines' CUDA stage).
@@ -666,12 +847,12 @@ std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Option
   return std::make_unique<Impl>(s, o);
 }
 
-std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile) {
-  if (v == Variant::fused) throw std::invalid_argument("cuda-fused is a whole step, not a force pass");
+std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, const Options& o) {
+  if (o.variant == Variant::fused) throw std::invalid_argument("cuda-fused is a whole step, not a force pass");
   if (const std::string why = unavailable(); !why.empty()) throw std::invalid_argument(why);
   validate(p, m.node_count());
-  if (v == Variant::tiled || m.topology != Topology::general) check_tile(m, tile);
-  return std::make_unique<DeviceForcePass>(m, p, Options{v, tile, false});
+  if (o.variant == Variant::tiled || m.topology != Topology::general) check_tile(m, o.tile);
+  return std::make_unique<DeviceForcePass>(m, p, o);
 }
 
-}  // namespace deformlab::cuda
+}  // namespace deformlab::cuda::DL_CUDA_MATH

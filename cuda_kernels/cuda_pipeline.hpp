@@ -19,6 +19,8 @@ enum class Variant {
             // mesh tile of core/partition.hpp (tile.x * tile.y nodes along the Z-order, and its halo)
   scatter,  // one thread per spring, +f / -f added with atomics (not bitwise deterministic)
   fused,    // gather + update + constraints in one kernel for one-force-pass integrators
+  temporal, // fused's step k times per launch on a shared-memory tile with a 2k-node halo
+            // (grids; explicit Euler, semi-implicit Euler, Verlet)
 };
 const char* to_string(Variant v);
 
@@ -32,6 +34,17 @@ Tile parse_tile(const std::string& s);
 // The tile named by the pipeline option "tile" ("WxH"), else the default.
 Tile tile_option(const PipelineOptions& o);
 
+// cuda-temporal's tile: the nodes each thread block writes (z: layers, on lattices). Zero: the
+// largest square (cube) whose region with its halo fits the device's shared memory.
+struct TemporalTile {
+  int x = 0, y = 0, z = 0;
+};
+// The option "tile" of cuda-temporal, "WxH" or (lattices) "WxHxD"; throws std::invalid_argument.
+TemporalTile parse_temporal_tile(const std::string& s);
+// The option "steps_per_launch" (1..8), else 0 (the default of the model: steps_per_launch
+// below); throws std::invalid_argument.
+int steps_per_launch_option(const PipelineOptions& o);
+
 struct Options {
   Variant variant = Variant::fused;
   Tile tile;
@@ -39,6 +52,9 @@ struct Options {
   // change from step to step (no drag handle moving). Measured on the H100 at 64^2-512^2:
   // 6-13% off a two-kernel step, nothing off the one-kernel fused step.
   bool graphs = true;
+  Math math = Math::exact;  // the kernels' arithmetic (the build of cuda_pipeline.cu that runs)
+  int steps_per_launch = 0;  // cuda-temporal: steps per launch (k); 0: the model's default
+  TemporalTile temporal_tile;
 };
 
 class CudaPipeline : public Pipeline {
@@ -51,10 +67,18 @@ class CudaPipeline : public Pipeline {
   std::string timing_method() const override { return "CUDA events"; }
 };
 
+// The registry's options (tile, steps_per_launch, math) as variant v reads them; throws
+// std::invalid_argument on a bad value.
+Options options_of(Variant v, const PipelineOptions& o);
+
+// cuda-temporal's steps per launch on model m: the option, else 4 on cloths and 2 on lattices
+// (whose halo grows in three axes: with 4, no tile fits 227 KB of shared memory).
+int steps_per_launch(const Model& m, const Options& o);
+
 // Empty when a CUDA device can be used, else the reason (no driver, no device).
 std::string unavailable();
-// Empty when the CUDA pipelines run this integrator, else the reason.
-std::string unsupported(Integrator i);
+// Empty when variant v runs this integrator, else the reason.
+std::string unsupported(Integrator i, Variant v);
 
 // Device bytes of a general model's springs as variant v reads them (the CSR adjacency, or
 // the scatter's spring list); 0 for grids, whose springs are the stencil.
@@ -83,6 +107,6 @@ DeviceInfo device_info();
 double copy_ms(std::int64_t bytes, int reps);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.
-double floor_bytes_per_node(const Model& m, Integrator i, Variant v);
+double floor_bytes_per_node(const Model& m, Integrator i, const Options& o);
 
 }  // namespace deformlab::cuda

@@ -22,8 +22,8 @@ class ForcePass {
   virtual void set_drag(const DragHandle& d) = 0;
 };
 
-// The naive, tiled or scatter force pass on the current device; throws std::invalid_argument
-// for fused (not a force pass), a bad tile or a model that does not fit.
-std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile);
+// The naive, tiled or scatter force pass on the current device, built with `math`; throws
+// std::invalid_argument for fused (not a force pass), a bad tile or a model that does not fit.
+std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile, Math math);
 
 }  // namespace deformlab::cuda

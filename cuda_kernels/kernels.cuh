@@ -1,7 +1,8 @@
 // Device helpers and kernels of the CUDA pipelines. Every formula comes from the shared
 // per-node physics (core/node_physics.h, as Physics<float>); per node the kernels do the CPU
 // pipeline's float arithmetic in the same order. Positions are float4 (xyz + inverse mass in
-// w), velocities and accelerations float4 with w unused.
+// w), velocities and accelerations float4 with w unused. Built once per math mode (DL_CUDA_MATH:
+// exact or fast, cuda_kernels/CMakeLists.txt), each in its own namespace.
 #pragma once
 #include <cuda_runtime.h>
 
@@ -11,7 +12,7 @@
 #include "core/integrator.hpp"
 #include "core/physics.hpp"
 
-namespace deformlab::cuda::dev {
+namespace deformlab::cuda::DL_CUDA_MATH::dev {
 
 using P = Physics<float>;
 using StepParams = P::StepParams;
@@ -169,13 +170,15 @@ __device__ __forceinline__ Window load_tile(const StepParams& s, const float4* _
   const int tw = blockDim.x + 2 * kHalo, th = blockDim.y + 2 * kHalo, hz = Volume ? kHalo : 0;
   const int cells = tw * th * (2 * hz + 1);
   const int i0 = blockIdx.x * blockDim.x - kHalo, j0 = blockIdx.y * blockDim.y - kHalo, k0 = blockIdx.z - hz;
-  for (int l = threadIdx.y * blockDim.x + threadIdx.x; l < cells; l += blockDim.x * blockDim.y) {
-    const int a = i0 + l % tw, b = j0 + (l / tw) % th, c = k0 + l / (tw * th);
-    if (a < 0 || a >= s.nx || b < 0 || b >= s.ny || c < 0 || c >= s.nz) continue;
-    const std::int64_t g = (std::int64_t(c) * s.ny + b) * s.nx + a;
-    sh[l] = x[g];
-    if (Damped) sh[cells + l] = v[g];
-  }
+  for (int c = 0; c < 2 * hz + 1; ++c)  // loops rather than one index: no divisions
+    for (int b = threadIdx.y; b < th; b += blockDim.y)
+      for (int a = threadIdx.x; a < tw; a += blockDim.x) {
+        const int gi = i0 + a, gj = j0 + b, gk = k0 + c, l = (c * th + b) * tw + a;
+        if (gi < 0 || gi >= s.nx || gj < 0 || gj >= s.ny || gk < 0 || gk >= s.nz) continue;
+        const std::int64_t g = (std::int64_t(gk) * s.ny + gj) * s.nx + gi;
+        sh[l] = x[g];
+        if (Damped) sh[cells + l] = v[g];
+      }
   __syncthreads();
   const int base = (hz * th + threadIdx.y + kHalo) * tw + threadIdx.x + kHalo;
   return {sh, Damped ? sh + cells : nullptr, base, tw, tw * th};
@@ -399,4 +402,4 @@ __global__ void combine(StepParams s, const float4* __restrict__ x, const float4
   if (result) store_displacement(check, d);
 }
 
-}  // namespace deformlab::cuda::dev
+}  // namespace deformlab::cuda::DL_CUDA_MATH::dev

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "cuda_pipeline.hpp"
+#include "math_builds.hpp"
 
 namespace deformlab {
 namespace cuda {
@@ -13,6 +14,7 @@ const char* to_string(Variant v) {
     case Variant::tiled: return "tiled";
     case Variant::scatter: return "scatter";
     case Variant::fused: return "fused";
+    case Variant::temporal: return "temporal";
   }
   return "?";
 }
@@ -35,11 +37,70 @@ Tile tile_option(const PipelineOptions& o) {
   return it == o.end() ? Tile{} : parse_tile(it->second);
 }
 
-std::string unsupported(Integrator i) {
+TemporalTile parse_temporal_tile(const std::string& s) {
+  TemporalTile t;
+  int* axes[] = {&t.x, &t.y, &t.z};
+  std::size_t at = 0;
+  int n = 0;
+  try {
+    for (; n < 3 && at <= s.size(); ++n) {
+      const std::size_t end = std::min(s.find('x', at), s.size());
+      std::size_t used = 0;
+      *axes[n] = std::stoi(s.substr(at, end - at), &used);
+      if (used != end - at || *axes[n] < 1 || *axes[n] > 4096) throw std::invalid_argument(s);
+      at = end + 1;
+    }
+    if (n < 2 || at <= s.size()) throw std::invalid_argument(s);
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument("cuda-temporal tile '" + s + "' is not WxH or WxHxD nodes (e.g. 40x40)");
+  }
+  return t;
+}
+
+int steps_per_launch_option(const PipelineOptions& o) {
+  const auto it = o.find("steps_per_launch");
+  if (it == o.end()) return 0;
+  try {
+    std::size_t used = 0;
+    const int k = std::stoi(it->second, &used);
+    if (used == it->second.size() && k >= 1 && k <= 8) return k;
+  } catch (const std::logic_error&) {
+  }
+  throw std::invalid_argument("option steps_per_launch '" + it->second + "' is not a count from 1 to 8");
+}
+
+int steps_per_launch(const Model& m, const Options& o) {
+  return o.steps_per_launch > 0 ? o.steps_per_launch : m.volume() ? 2 : 4;
+}
+
+std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
+  return o.math == Math::fast ? fast::make_pipeline(s, o) : exact::make_pipeline(s, o);
+}
+
+std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile, Math math) {
+  const Options o{v, tile, false, math};
+  return math == Math::fast ? fast::make_force_pass(m, p, o) : exact::make_force_pass(m, p, o);
+}
+
+std::string unsupported(Integrator i, Variant v) {
   if (i == Integrator::backward_euler)
     return "backward-euler needs a linear solve per step, which the CUDA pipelines do not have (use cpu, omp or "
            "reference)";
+  if (v == Variant::temporal && !make_schedule(i).single_pass())
+    return std::string(info(i).name) + " evaluates forces more than once a step; cuda-temporal runs explicit-euler, "
+           "semi-implicit-euler and verlet (use cuda-fused)";
   return {};
+}
+
+Options options_of(Variant v, const PipelineOptions& o) {
+  Options out{v, {}, true, math_option(o)};
+  if (v != Variant::temporal) {
+    out.tile = tile_option(o);
+    return out;
+  }
+  out.steps_per_launch = steps_per_launch_option(o);
+  if (const auto it = o.find("tile"); it != o.end()) out.temporal_tile = parse_temporal_tile(it->second);
+  return out;
 }
 
 std::int64_t spring_bytes(const ModelSize& m, Variant v) {
@@ -56,12 +117,15 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   const std::int64_t n = m.nodes, f4 = 16;
   std::int64_t b = n * 4 * f4;  // two (x, v) buffers
   b += n * 2 * f4 * s.stage_states;
-  if (!(o.variant == Variant::fused && s.single_pass())) b += n * f4 * s.accel_slots;
+  const bool one_kernel = (o.variant == Variant::fused || o.variant == Variant::temporal) && s.single_pass();
+  if (!one_kernel) b += n * f4 * s.accel_slots;
+  if (o.variant == Variant::temporal && s.rule == UpdateRule::verlet) b += n * 2 * f4;  // previous positions' pair
   b += (n / 32 + 1024) * 4 * 2;  // the stop rule's warp maxima (tile padding at most doubles them)
   return b + spring_bytes(m, o.variant);
 }
 
-double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
+double floor_bytes_per_node(const Model& m, Integrator i, const Options& o) {
+  const Variant v = o.variant;
   const Schedule s = make_schedule(i);
   const double f4 = 16, springs_per_node = m.node_count() ? double(m.spring_count()) / m.node_count() : 0;
   const double prev = s.rule == UpdateRule::verlet ? f4 : 0;
@@ -72,6 +136,7 @@ double floor_bytes_per_node(const Model& m, Integrator i, Variant v) {
                                              : 3 * f4 + links;
   if (s.single_pass()) {
     if (v == Variant::fused) return 4 * f4 + prev + links;  // (x, v) in, (x', v') out
+    if (v == Variant::temporal) return (4 * f4 + 2 * prev) / steps_per_launch(m, o);  // per step, halo not counted
     return force + 3 * f4 + prev + 2 * f4;                  // update: x, v, a (+ x_prev) in, x', v' out
   }
   double b = 0;
@@ -101,23 +166,27 @@ void add_cuda_pipelines(PipelineRegistry& r) {
       {"cuda-scatter", Variant::scatter, "CUDA, one thread per spring, atomic scatter of +f/-f"},
       {"cuda-fused", Variant::fused,
        "CUDA, force + update + constraints in one kernel (one-pass integrators; others use the plain gather)"},
+      {"cuda-temporal", Variant::temporal,
+       "CUDA, k fused steps per launch on shared-memory tiles with a 2k-node halo (grids; one-pass integrators)"},
   };
   for (const Entry& e : entries) {
     const Variant v = e.v;
     // The gathers give the CPU's bits (tests/cuda); atomics add a node's forces in any order.
     const bool gather = v != Variant::scatter;
-    const PipelineTraits traits{Engine::cuda, Engine::cuda, gather, gather ? CpuMatch::bitwise : CpuMatch::rounding};
-    // "tile": the thread block shape WxH of the grid kernels (default 16x8).
+    const PipelineTraits traits{Engine::cuda, Engine::cuda, gather, gather ? CpuMatch::bitwise : CpuMatch::rounding,
+                                v == Variant::temporal};
+    // "tile": the thread block shape WxH of the grid kernels (default 16x8); on cuda-temporal
+    // the nodes a block writes, with "steps_per_launch".
     std::vector<std::string> options;
     if (gather) options.push_back("tile");
+    if (v == Variant::temporal) options.push_back("steps_per_launch");
+    options.push_back("math");
     r.add({e.name, e.summary, traits, [] { return cuda::unavailable(); },
-           [](Integrator i) { return cuda::unsupported(i); },
-           [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> {
-             return cuda::make_pipeline(s, {v, cuda::tile_option(s.options), true});
-           },
+           [v](Integrator i) { return cuda::unsupported(i, v); },
+           [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> { return cuda::make_pipeline(s, options_of(v, s.options)); },
            options,
-           [v](const ModelSize& m, Integrator i, const PipelineOptions&) {
-             return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, {v})};
+           [v](const ModelSize& m, Integrator i, const PipelineOptions& o) {
+             return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, cuda::options_of(v, o))};
            }});
   }
 }

@@ -31,19 +31,22 @@ constexpr PipelineTraits on(Engine e, bool deterministic = true, CpuMatch m = Cp
 }
 constexpr PipelineTraits hybrid(Engine update) { return {Engine::cuda, update, true, CpuMatch::rounding}; }
 
-// In order of expected speed on a GPU machine; the CPU pipelines close the list.
+// In order of expected speed on a GPU machine (cuda-temporal, faster on grids, follows
+// cuda-fused, which runs every model); the CPU pipelines close the list.
 const Known kKnown[] = {
-    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
-    {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
+    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
+    {"cuda-temporal", "CUDA, k fused steps per launch on shared-memory tiles (grids)", "CUDA",
+     {Engine::cuda, Engine::cuda, true, CpuMatch::bitwise, true}, {"tile", "steps_per_launch", "math"}},
+    {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
     {"cuda-naive", "CUDA, one thread per node gathering from global memory", "CUDA",
-     on(Engine::cuda, true, CpuMatch::bitwise), {"tile"}},
-    {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false)},
+     on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
+    {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false), {"math"}},
     {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute), {"window", "link_view"}},
     {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL", on(Engine::gl_transform_feedback), {"link_view"}},
     {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL",
-     hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile"}},
+     hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile", "math"}},
     {"hybrid-compute", "CUDA forces into GL buffers, compute-shader update", "CUDA and OpenGL",
-     hybrid(Engine::gl_compute), {"interop", "force", "tile"}},
+     hybrid(Engine::gl_compute), {"interop", "force", "tile", "math"}},
     {"omp", "", "", {}},
     {"cpu", "", "", {}},
     {"reference", "", "", {.cpu_match = CpuMatch::rounding}},

@@ -18,9 +18,10 @@ struct HybridOptions {
   Mode mode = Mode::map;
   cuda::Variant force = cuda::Variant::naive;  // naive, tiled or scatter
   cuda::Tile tile;                              // thread block of the grid force kernels
+  Math math = Math::exact;                      // the CUDA force pass's and the GL update's arithmetic
 };
 
-// Reads the pipeline options `interop`, `force` and `tile` (throws std::invalid_argument on a
+// Reads the pipeline options `interop`, `force`, `tile` and `math` (throws std::invalid_argument on a
 // bad value).
 HybridOptions hybrid_options(const PipelineOptions& o, Update u);
 // Empty when the integrator runs on the hybrid pipelines, else why not.

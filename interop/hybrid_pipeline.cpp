@@ -27,6 +27,7 @@ HybridOptions hybrid_options(const PipelineOptions& o, Update u) {
     else throw std::invalid_argument("force '" + f + "' is not a CUDA force pass of the hybrid pipelines (naive, tiled, scatter)");
   }
   h.tile = cuda::tile_option(o);
+  h.math = math_option(o);
   return h;
 }
 
@@ -47,7 +48,7 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
   HybridPipeline(const PipelineSetup& s, const HybridOptions& o) : p_(s.params), sched_(make_schedule(s.integrator)) {
     if (const std::string why = hybrid_unsupported(s.integrator); !why.empty()) throw std::invalid_argument(why);
     sb_ = make_shared_buffers(o.mode);  // selects the CUDA device behind the GL context
-    fp_ = cuda::make_force_pass(s.model, p_, o.force, o.tile);
+    fp_ = cuda::make_force_pass(s.model, p_, o.force, o.tile, o.math);
     auto shared = [this](std::size_t bytes, gl::NodeRole role) {
       return sb_->add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
     };

@@ -15,7 +15,7 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   auto unsupported = [](Integrator i) { return interop::hybrid_unsupported(i); };
   // CUDA forces, a GL update: equal to the CPU within rounding.
   auto updating_on = [](Engine e) { return PipelineTraits{Engine::cuda, e, true, CpuMatch::rounding}; };
-  const std::vector<std::string> options = {"interop", "force", "tile"};
+  const std::vector<std::string> options = {"interop", "force", "tile", "math"};
   // The GL update's buffers (the states the forces read and the accelerations shared with
   // CUDA) and the CUDA force pass's springs.
   auto footprint = [](Update u) {
@@ -25,13 +25,13 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
       return f;
     };
   };
-  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile)",
+  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile, math)",
          updating_on(Engine::gl_transform_feedback), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
          },
          options, footprint(Update::transform_feedback)});
-  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile)",
+  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile, math)",
          updating_on(Engine::gl_compute), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));

@@ -3,8 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments timing scale endurance" to
-# run, default all but timing, scale and endurance),
+# Environment: PARTS (which of "tests sanitizers bench experiments timing scale endurance speed"
+# to run, default all but timing, scale, endurance and speed),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
@@ -35,7 +35,7 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
   for tool in memcheck racecheck synccheck initcheck; do
     {
       compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*'
-      compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*'
+      compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*:CudaTemporal*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
   done
@@ -52,6 +52,33 @@ if part bench; then
   bench_pair gl gl --sizes 256 1024 2048
   bench_pair hybrid hybrid --sizes 256 1024 --updates compute --modes map external-gpusync --no-baselines
   bench_pair draw draw --sizes 256 1024 2048 4096
+fi
+
+# The roofline work: cuda-fused in exact and fast math and cuda-temporal's steps per launch
+# (bench), Nsight Compute's view of the fused and temporal kernels on the paper's scene at
+# 2048^2, and cuda-temporal timed by run, by its experiment cell and by the bench.
+if part speed; then
+  "$bench" cuda --sizes 2048 --variants fused --integrator explicit-euler --graph-sizes 64 --tiles 16x8 \
+    --temporal-sizes 2048 8192 --csv "$out/speed-bench.csv" >"$out/speed-bench.txt" 2>&1
+  if command -v ncu >/dev/null; then
+    for math in exact fast; do
+      for integ in explicit-euler semi-implicit-euler verlet; do
+        ncu --kernel-name regex:fused_grid --launch-skip 20 --launch-count 1 --section SpeedOfLight \
+          --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis --section InstructionStats \
+          --section WarpStateStats --section Occupancy --section LaunchStats \
+          "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-fused --integrator "$integ" \
+          --option math=$math --steps 30 --no-state --out "/tmp/ncu-run" >"$out/ncu-fused-$integ-$math.txt" 2>&1
+      done
+      ncu --kernel-name regex:temporal_grid --launch-skip 5 --launch-count 1 --section SpeedOfLight \
+        --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis --section InstructionStats \
+        --section WarpStateStats --section Occupancy --section LaunchStats \
+        "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-temporal --integrator semi-implicit-euler \
+        --option math=$math --steps 40 --check-every 4 --no-state --out "/tmp/ncu-run" >"$out/ncu-temporal-$math.txt" 2>&1
+    done
+  fi
+  "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-temporal --integrator semi-implicit-euler \
+    --steps 400 --check-every 4 --no-state --out /tmp/speed-run >"$out/speed-run-temporal.txt" 2>&1
+  summary+=("speed: $(grep -A200 '^\[temporal\]' "$out/speed-bench.txt" | grep -E '^ *2048\^2 *semi-implicit' | tr -s ' ' | head -10 | tr '\n' ';')")
 fi
 
 if part experiments; then

@@ -12,25 +12,6 @@ using cuda::Variant;
 constexpr int kSteps = 30;
 constexpr Variant kVariants[] = {Variant::naive, Variant::tiled, Variant::scatter, Variant::fused};  // the drag path ends after 10: later steps replay a CUDA graph
 
-struct ContactScene {
-  Model m;
-  Params p;
-  std::vector<int> pinned;
-};
-
-ContactScene make_contact_scene(bool spring_drag) {
-  ContactScene s{small_cloth(37, 53), small_params(), {}};
-  s.m.damping = {0.02f, 0.02f, 0.01f};
-  s.pinned = pin_nodes(s.m, PinSet::top_corners, {});
-  s.p.ground = 0.995f;  // just under the cloth: gravity and the perturbation push nodes below
-  s.p.spheres = {{{0.f, 0.9f, 0.f}, 0.12f}, {{0.5f, 0.97f, 0.3f}, 0.06f}};  // both cut the cloth from below
-  s.p.drag.node = 18 * 37 + 30;
-  s.p.drag.as_spring = spring_drag;
-  s.p.drag.path = {{0.f, s.m.rest_position[s.p.drag.node]},
-                   {0.01f, s.m.rest_position[s.p.drag.node] + Vec3f{0.02f, 0.05f, -0.01f}}};
-  return s;
-}
-
 void expect_constraints_hold(const ContactScene& sc, const State& s0, const State& g, const std::string& what) {
   for (int i : sc.pinned) {
     EXPECT_TRUE(g.x[i] == s0.x[i]) << what << ": pinned node " << i << " moved";
@@ -50,7 +31,7 @@ void expect_constraints_hold(const ContactScene& sc, const State& s0, const Stat
 TEST(CudaConstraints, PinsGroundSpheresAndDragHold) {
   DEFORMLAB_REQUIRE_CUDA();
   for (bool spring_drag : {false, true}) {
-    const ContactScene sc = make_contact_scene(spring_drag);
+    const ContactScene sc = contact_scene(small_cloth(37, 53), spring_drag);
     const State s0 = perturbed_state(sc.m, 21u);
     for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
                              Integrator::rk4, Integrator::verlet}) {

@@ -204,17 +204,19 @@ TEST(CudaPipeline, RefusesASizeThatDoesNotFit) {
 // ---- no device needed ----
 
 TEST(CudaPipeline, BackwardEulerIsRefusedWithAReason) {
-  EXPECT_NE(cuda::unsupported(Integrator::backward_euler).find("backward-euler"), std::string::npos);
-  for (Integrator i : kIntegrators) EXPECT_EQ(cuda::unsupported(i), "");
+  for (Variant v : kVariants) {
+    EXPECT_NE(cuda::unsupported(Integrator::backward_euler, v).find("backward-euler"), std::string::npos);
+    for (Integrator i : kIntegrators) EXPECT_EQ(cuda::unsupported(i, v), "");
+  }
   const Model m = make_model(kShapes[1]);
   EXPECT_THROW(cuda::make_pipeline({m, scene_params(), Integrator::backward_euler}, {}), std::invalid_argument);
 }
 
-TEST(CudaPipeline, RegistryNamesTheFourVariants) {
+TEST(CudaPipeline, RegistryNamesTheFiveVariants) {
   PipelineRegistry r;
   add_cuda_pipelines(r);
-  ASSERT_EQ(r.all().size(), 4u);
-  for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-scatter", "cuda-fused"}) {
+  ASSERT_EQ(r.all().size(), 5u);
+  for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-scatter", "cuda-fused", "cuda-temporal"}) {
     const PipelineEntry* e = r.find(n);
     ASSERT_NE(e, nullptr) << n;
     EXPECT_EQ(e->traits.deterministic, std::string(n) != "cuda-scatter") << n;
@@ -234,12 +236,16 @@ TEST(CudaPipeline, WithoutADeviceMakingAPipelineFailsWithTheReason) {
   }
 }
 
-TEST(CudaPipeline, TileShapeIsAPipelineOption) {
+TEST(CudaPipeline, TileShapeAndMathArePipelineOptions) {
   PipelineRegistry r;
   add_cuda_pipelines(r);
   for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-fused"})
-    EXPECT_EQ(r.find(n)->options, std::vector<std::string>{"tile"}) << n;
-  EXPECT_TRUE(r.find("cuda-scatter")->options.empty());
+    EXPECT_EQ(r.find(n)->options, (std::vector<std::string>{"tile", "math"})) << n;
+  EXPECT_EQ(r.find("cuda-scatter")->options, std::vector<std::string>{"math"});
+  EXPECT_EQ(r.find("cuda-temporal")->options, (std::vector<std::string>{"tile", "steps_per_launch", "math"}));
+  EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {{"math", "fast"}}).math, Math::fast);
+  EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {}).math, Math::exact);
+  EXPECT_THROW(cuda::options_of(cuda::Variant::fused, {{"math", "fastest"}}), std::invalid_argument);
   EXPECT_EQ(cuda::tile_option({{"tile", "32x4"}}).x, 32);
   EXPECT_EQ(cuda::tile_option({}).x, cuda::Tile{}.x);
   EXPECT_THROW(cuda::tile_option({{"tile", "0x4"}}), std::invalid_argument);

@@ -39,6 +39,27 @@ inline Tolerance rounding_floor(const State& s, float dt) {
   return {4 * ulp, 4 * ulp / dt};
 }
 
+// Model m (damped, its top corners pinned) with a ground just under it at 1 m, two spheres
+// cutting it from below and a free node dragged along a path that ends after 10 ms, hard or
+// by a spring: every constraint of a step at work.
+struct ContactScene {
+  Model m;
+  Params p;
+  std::vector<int> pinned;
+};
+inline ContactScene contact_scene(Model m, bool spring_drag) {
+  ContactScene s{std::move(m), small_params(), {}};
+  s.m.damping = {0.02f, 0.02f, 0.01f};
+  s.pinned = pin_nodes(s.m, PinSet::top_corners, {});
+  s.p.ground = 0.995f;  // just under the cloth: gravity and the perturbation push nodes below
+  s.p.spheres = {{{0.f, 0.9f, 0.f}, 0.12f}, {{0.5f, 0.97f, 0.3f}, 0.06f}};  // both cut the cloth from below
+  s.p.drag.node = s.m.node_count() / 2 + s.m.nx / 3;
+  s.p.drag.as_spring = spring_drag;
+  s.p.drag.path = {{0.f, s.m.rest_position[s.p.drag.node]},
+                   {0.01f, s.m.rest_position[s.p.drag.node] + Vec3f{0.02f, 0.05f, -0.01f}}};
+  return s;
+}
+
 inline const char* name(cuda::Variant v) { return cuda::to_string(v); }
 
 inline cuda::Options options(cuda::Variant v, bool graphs = true, cuda::Tile tile = {}) { return {v, tile, graphs}; }

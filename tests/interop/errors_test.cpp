@@ -39,7 +39,7 @@ TEST(InteropOptions, RegistryDeclaresTheOptionsAndRefusesBackwardEuler) {
   for (const char* name : {"hybrid", "hybrid-compute"}) {
     const PipelineEntry* e = r.find(name);
     ASSERT_NE(e, nullptr) << name;
-    EXPECT_EQ(e->options, (std::vector<std::string>{"interop", "force", "tile"}));
+    EXPECT_EQ(e->options, (std::vector<std::string>{"interop", "force", "tile", "math"}));
     EXPECT_NE(e->unsupported(Integrator::backward_euler).find("linear solve"), std::string::npos);
     EXPECT_TRUE(e->unsupported(Integrator::rk4).empty());
   }

@@ -1,0 +1,182 @@
+// cuda-temporal against cuda-fused: k steps a launch on shared-memory tiles give fused's
+// states. With exact math bit for bit (per node and step the same operations in the same
+// order), with fast math within the rounding tolerance of tests/match (8x the CPU float run's
+// distance from the double reference on the same trajectory, floored at a few ulp): the
+// compiler contracts each kernel's expressions in its own way. Odd grid sizes, tiles much
+// smaller than the grid (halos crossing several blocks) and runs of 2k + 3 steps (the last
+// launch short) on cloths and lattices, with every constraint at work.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "cuda_kernels/pipelines.hpp"
+#include "cuda_test_support.hpp"
+
+namespace deformlab::test {
+namespace {
+
+using cuda::Variant;
+
+const Integrator kOnePass[] = {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet};
+
+struct Scene {
+  std::string name;
+  ContactScene sc;
+  cuda::TemporalTile tile;  // small: many blocks
+  std::vector<int> ks;
+};
+
+std::vector<Scene> scenes() {
+  std::vector<Scene> out;
+  for (bool spring : {false, true}) {
+    const std::string drag = spring ? " spring drag" : " hard drag";
+    out.push_back({"cloth 37x53" + drag, contact_scene(small_cloth(37, 53), spring), {8, 6, 1}, {1, 2, 4, 8}});
+    out.push_back({"cloth 61x29" + drag, contact_scene(small_cloth(61, 29), spring), {13, 7, 1}, {1, 3, 8}});
+    out.push_back({"lattice 9x7x11" + drag, contact_scene(small_lattice(9, 7, 11), spring), {3, 3, 3}, {1, 2}});
+  }
+  // Free of constraints but for the pins: wind and spring damping only.
+  ContactScene free = contact_scene(small_cloth(45, 31), false);
+  free.p = small_params();
+  free.p.wind = {0.002f, 0.f, -0.001f};
+  out.push_back({"cloth 45x31 free", free, {16, 16, 1}, {1, 2, 4, 8}});
+  return out;
+}
+
+cuda::Options temporal(int k, cuda::TemporalTile t, Math math) {
+  cuda::Options o{Variant::temporal, {}, true, math};
+  o.steps_per_launch = k;
+  o.temporal_tile = t;
+  return o;
+}
+
+TEST(CudaTemporal, ExactMatchesCudaFusedBitForBit) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (const Scene& s : scenes())
+    for (Integrator integ : kOnePass)
+      for (int k : s.ks)
+        for (bool default_tile : {false, true}) {
+          const std::string what = s.name + " " + std::string(info(integ).name) + " k=" + std::to_string(k) +
+                                   (default_tile ? " default tile" : " small tile");
+          const State s0 = perturbed_state(s.sc.m, 5u);
+          const int steps = 2 * k + 3;
+          auto fused = cuda::make_pipeline({s.sc.m, s.sc.p, integ}, options(Variant::fused));
+          auto t = cuda::make_pipeline({s.sc.m, s.sc.p, integ},
+                                       temporal(k, default_tile ? cuda::TemporalTile{} : s.tile, Math::exact));
+          const State f = advance(*fused, s0, steps), g = advance(*t, s0, steps);
+          ASSERT_GT(max_position_diff(f, s0), 1e-5) << what << ": the scene must move";
+          EXPECT_TRUE(bitwise_equal(g, f)) << what << ": |x - x_fused| = " << max_position_diff(g, f);
+          EXPECT_EQ(t->max_displacement(), fused->max_displacement()) << what;
+        }
+}
+
+TEST(CudaTemporal, FastMatchesCudaFusedWithinRounding) {
+  DEFORMLAB_REQUIRE_CUDA();
+  for (const Scene& s : scenes())
+    for (Integrator integ : kOnePass) {
+      const State s0 = perturbed_state(s.sc.m, 5u);
+      const int steps = 19;
+      auto cpu = make_cpu_pipeline({s.sc.m, s.sc.p, integ}, Precision::f32, true);
+      auto ref = make_cpu_pipeline({s.sc.m, s.sc.p, integ}, Precision::f64, true);
+      const State c = advance(*cpu, s0, steps), r = advance(*ref, s0, steps);
+      const Tolerance floor = rounding_floor(c, s.sc.p.dt);
+      const double tol_x = std::max(8 * max_position_diff(c, r), floor.x);
+      const double tol_v = std::max(8 * max_velocity_diff(c, r), floor.v);
+      cuda::Options fo = options(Variant::fused);
+      fo.math = Math::fast;
+      auto fused = cuda::make_pipeline({s.sc.m, s.sc.p, integ}, fo);
+      const State f = advance(*fused, s0, steps);
+      for (int k : s.ks) {
+        const std::string what = s.name + " " + std::string(info(integ).name) + " k=" + std::to_string(k);
+        auto t = cuda::make_pipeline({s.sc.m, s.sc.p, integ}, temporal(k, s.tile, Math::fast));
+        const State g = advance(*t, s0, steps);
+        EXPECT_LE(max_position_diff(g, f), tol_x) << what;
+        EXPECT_LE(max_velocity_diff(g, f), tol_v) << what;
+        EXPECT_LE(std::abs(t->max_displacement() - fused->max_displacement()), 2 * tol_x) << what;
+        std::printf("%s fast: |x - x_fused| = %.3g m (tolerance %.3g), |v - v_fused| = %.3g m/s (tolerance %.3g)\n",
+                    what.c_str(), max_position_diff(g, f), tol_x, max_velocity_diff(g, f), tol_v);
+      }
+    }
+}
+
+TEST(CudaTemporal, ConstraintsHoldAcrossLaunches) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const ContactScene sc = contact_scene(small_cloth(37, 53), false);
+  const State s0 = perturbed_state(sc.m, 21u);
+  auto t = cuda::make_pipeline({sc.m, sc.p, Integrator::semi_implicit_euler}, temporal(8, {8, 6, 1}, Math::exact));
+  const State g = advance(*t, s0, 21);
+  for (int i : sc.pinned) EXPECT_TRUE(g.x[i] == s0.x[i]) << "pinned node " << i << " moved";
+  for (int i = 0; i < sc.m.node_count(); ++i) {
+    if (sc.m.pinned(i)) continue;
+    EXPECT_GE(g.x[i].y, *sc.p.ground) << "node " << i << " under the ground";
+    for (const Sphere& sp : sc.p.spheres)
+      EXPECT_GE(norm(g.x[i] - sp.center), sp.radius * (1 - 1e-6f)) << "node " << i << " inside a sphere";
+  }
+  EXPECT_TRUE(g.x[sc.p.drag.node] == sc.p.drag.target(g.t)) << "hard drag node off its target";
+}
+
+// The stop rule's check sees the last step of a launch: a NaN put into the state is found.
+TEST(CudaTemporal, FindsANonFiniteState) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = small_cloth(37, 53);
+  State s0 = perturbed_state(m, 3u);
+  s0.v[700].y = std::numeric_limits<float>::quiet_NaN();
+  for (int k : {1, 4}) {
+    auto t = cuda::make_pipeline({m, small_params(), Integrator::semi_implicit_euler}, temporal(k, {8, 6, 1}, Math::exact));
+    advance(*t, s0, 2 * k);
+    EXPECT_TRUE(std::isnan(t->max_displacement())) << "k=" << k;
+  }
+}
+
+// Steps held for a launch are timed as their share of it: every step gets a time.
+TEST(CudaTemporal, EveryStepIsTimed) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = small_cloth(64, 64);
+  auto t = cuda::make_pipeline({m, small_params(), Integrator::verlet}, temporal(4, {}, Math::exact));
+  auto timer = t->step_timer();
+  const std::vector<double> ms = timed_steps(*t, *timer, 10);  // two launches of 4, one of 2
+  ASSERT_EQ(ms.size(), 10u);
+  for (double x : ms) EXPECT_GT(x, 0.0);
+  EXPECT_EQ(ms[0], ms[3]);  // one launch's share
+  EXPECT_EQ(ms[8], ms[9]);
+}
+
+TEST(CudaTemporal, RefusesWhatItDoesNotRun) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Params p = small_params();
+  auto refused = [&](const Model& m, Integrator i, const cuda::Options& o, const std::string& says) {
+    try {
+      cuda::make_pipeline({m, p, i}, o);
+      ADD_FAILURE() << "expected a refusal naming " << says;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  refused(small_lattice(9, 7, 11), Integrator::verlet, temporal(4, {}, Math::exact), "shared memory");
+  refused(small_cloth(37, 53), Integrator::verlet, temporal(2, {400, 400, 1}, Math::exact), "shared memory");
+  refused(explicit_springs(small_cloth(9, 9)), Integrator::verlet, temporal(2, {}, Math::exact), "grid models");
+  refused(small_cloth(9, 9), Integrator::rk4, temporal(2, {}, Math::exact), "cuda-temporal runs");
+}
+
+// ---- no device needed ----
+
+TEST(CudaTemporal, OptionsAreChecked) {
+  EXPECT_EQ(cuda::steps_per_launch_option({{"steps_per_launch", "8"}}), 8);
+  EXPECT_EQ(cuda::steps_per_launch_option({}), 0);
+  for (const char* bad : {"0", "9", "2x", "", "-1"})
+    EXPECT_THROW(cuda::steps_per_launch_option({{"steps_per_launch", bad}}), std::invalid_argument) << bad;
+  const cuda::TemporalTile t = cuda::parse_temporal_tile("40x24");
+  EXPECT_EQ(t.x, 40);
+  EXPECT_EQ(t.y, 24);
+  EXPECT_EQ(cuda::parse_temporal_tile("7x5x3").z, 3);
+  for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4"})
+    EXPECT_THROW(cuda::parse_temporal_tile(bad), std::invalid_argument) << bad;
+  EXPECT_EQ(cuda::steps_per_launch(small_cloth(4, 4), {}), 4);
+  EXPECT_EQ(cuda::steps_per_launch(small_lattice(4, 4, 4), {}), 2);
+  EXPECT_FALSE(cuda::unsupported(Integrator::rk4, Variant::temporal).empty());
+  EXPECT_EQ(cuda::unsupported(Integrator::verlet, Variant::temporal), "");
+}
+
+}  // namespace
+}  // namespace deformlab::test
