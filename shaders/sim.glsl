@@ -16,6 +16,10 @@
 #define VEC3(a, b, c) vec3(a, b, c)
 #define DL_FINITE(a) ((floatBitsToUint(a) & 0x7f800000u) != 0x7f800000u)
 #define DL_INFINITY uintBitsToFloat(0x7f800000u)
+#define DL_RECIP(a) (real(1) / (a))
+#define DL_DOT(a, b) dot(a, b)
+#define DL_LENGTH(a) length(a)
+#define DL_PRECISE
 #include "node_physics.h"
 
 #define PASS_ONE 0     // one force pass and the step's result: o0 = x', o1 = (v', displacement), o2 = x (Verlet)
