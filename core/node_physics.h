@@ -8,6 +8,12 @@
 //   VEC3(x, y, z)            a vector from its components
 //   DL_FINITE(a)             whether a scalar is finite (immune to fast math in GLSL)
 //   DL_INFINITY              +infinity
+//   DL_RECIP(a), DL_DOT(a, b), DL_LENGTH(a)
+//                            1 / a, a.b, |a|: the plain operations in C++ and CUDA; in GLSL's
+//                            exact math correctly rounded, and in C++'s order
+//   DL_PRECISE               GLSL's precise in exact math, else nothing: on the locals a
+//                            function's result is computed in (OUT and INOUT carry it), as precise
+//                            covers what a function computes into its own precise variables
 // No include guard: C++ includes it once per precision.
 
 #define DRAG_NONE 0
@@ -71,12 +77,13 @@ DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj
 // (The paper's eq. (2) drops the minus sign.) Coincident nodes exert no force.
 DL_FN vec3 spring_force(vec3 xi, vec3 xj, vec3 vi, vec3 vj, real k, real kd, real rest) {
   vec3 d = xi - xj;
-  real len = length(d);
+  real len = DL_LENGTH(d);
   if (len == real(0)) return ZERO3;
-  vec3 u = d * (real(1) / len);
+  vec3 u = d * DL_RECIP(len);
   real s = k * (len - rest);
-  if (kd != real(0)) s += kd * dot(vi - vj, u);  // skipped when undamped: same result, fewer instructions
-  return u * (-s);
+  if (kd != real(0)) s += kd * DL_DOT(vi - vj, u);  // skipped when undamped: same result, fewer instructions
+  DL_PRECISE vec3 f = u * (-s);
+  return f;
 }
 
 // Pinned nodes (zero inverse mass) and the hard-dragged node have no acceleration.
@@ -91,7 +98,8 @@ DL_FN vec3 node_acceleration(CREF(StepParams) p, int i, real inv_mass, vec3 x, v
   if (node_fixed(p, i, inv_mass)) return ZERO3;
   vec3 f = springs;
   if (p.drag_mode == DRAG_SPRING && i == p.drag_node) f += (drag_target - x) * p.drag_stiffness;
-  return (f + p.wind - v * p.damping) * inv_mass + p.gravity;
+  DL_PRECISE vec3 a = (f + p.wind - v * p.damping) * inv_mass + p.gravity;
+  return a;
 }
 
 // Runge-Kutta: a stage state, or a step's result, is s0 + dt sum_j w_j k_j. add_slope adds
@@ -116,7 +124,7 @@ DL_FN void one_pass_update(int rule, real weight, vec3 x, vec3 v, vec3 a, vec3 x
   } else if (rule == RULE_VERLET) {
     vec3 s = has_prev ? (x - x_prev) + a * (dt * dt) : v * dt + a * (real(0.5) * dt * dt);
     xo = x + s;
-    vo = s * (real(1) / dt);
+    vo = s * DL_RECIP(dt);
   } else {
     vec3 dx = ZERO3, dv = ZERO3;
     add_slope(dx, dv, weight, v, a);
@@ -136,11 +144,11 @@ DL_FN void ground_constraint(INOUT(vec3) x, INOUT(vec3) v, real h) {
 // and its inward normal velocity removed. A node at the exact centre goes out along +y.
 DL_FN void sphere_constraint(INOUT(vec3) x, INOUT(vec3) v, vec3 c, real r) {
   vec3 d = x - c;
-  real len = length(d);
+  real len = DL_LENGTH(d);
   if (len >= r) return;
-  vec3 n = len > real(0) ? d * (real(1) / len) : VEC3(real(0), real(1), real(0));
+  vec3 n = len > real(0) ? d * DL_RECIP(len) : VEC3(real(0), real(1), real(0));
   x = c + n * r;
-  real vn = dot(v, n);
+  real vn = DL_DOT(v, n);
   if (vn < real(0)) v -= n * vn;
 }
 
@@ -154,7 +162,7 @@ DL_FN void constrain_node(CREF(StepParams) p, int i, real inv_mass, vec3 x_old, 
     v = ZERO3;
   } else if (p.drag_mode == DRAG_HARD && i == p.drag_node) {
     x = drag_target;
-    v = (x - x_old) * (real(1) / p.dt);
+    v = (x - x_old) * DL_RECIP(p.dt);
   } else {
     if (p.has_ground != 0) ground_constraint(x, v, p.ground);
     for (int q = 0; q < p.sphere_count; ++q) sphere_constraint(x, v, p.spheres[q].center, p.spheres[q].radius);
@@ -164,7 +172,7 @@ DL_FN void constrain_node(CREF(StepParams) p, int i, real inv_mass, vec3 x_old, 
 // A node's term of the stop rule's reduction: |x - x_old|, or infinity when the new state is
 // not finite, so that the largest term over nodes also flags divergence.
 DL_FN real displacement(vec3 x, vec3 x_old, vec3 v) {
-  real d = length(x - x_old);
+  real d = DL_LENGTH(x - x_old);
   bool ok = DL_FINITE(d) && DL_FINITE(v.x) && DL_FINITE(v.y) && DL_FINITE(v.z);
   return ok ? d : DL_INFINITY;
 }
@@ -173,13 +181,13 @@ DL_FN real displacement(vec3 x, vec3 x_old, vec3 v) {
 // force fields (gravity, wind); a spring's potential energy.
 DL_FN real kinetic_energy(real inv_mass, vec3 v) {
   if (inv_mass == real(0)) return real(0);
-  return real(0.5) * (real(1) / inv_mass) * dot(v, v);
+  return real(0.5) * DL_RECIP(inv_mass) * DL_DOT(v, v);
 }
 DL_FN real field_energy(CREF(StepParams) p, real inv_mass, vec3 x) {
   if (inv_mass == real(0)) return real(0);
-  return -dot(p.gravity * (real(1) / inv_mass) + p.wind, x);
+  return -DL_DOT(p.gravity * DL_RECIP(inv_mass) + p.wind, x);
 }
 DL_FN real spring_energy(vec3 xi, vec3 xj, real k, real rest) {
-  real stretch = length(xi - xj) - rest;
+  real stretch = DL_LENGTH(xi - xj) - rest;
   return real(0.5) * k * stretch * stretch;
 }

@@ -18,6 +18,10 @@ struct Physics {
 #define VEC3(a, b, c) vec3{a, b, c}
 #define DL_FINITE(a) is_finite(a)
 #define DL_INFINITY std::numeric_limits<Real>::infinity()
+#define DL_RECIP(a) (real(1) / (a))
+#define DL_DOT(a, b) dot(a, b)
+#define DL_LENGTH(a) length(a)
+#define DL_PRECISE
 #include "node_physics.h"
 #undef DL_FN
 #undef CREF
@@ -26,6 +30,10 @@ struct Physics {
 #undef VEC3
 #undef DL_FINITE
 #undef DL_INFINITY
+#undef DL_RECIP
+#undef DL_DOT
+#undef DL_LENGTH
+#undef DL_PRECISE
 };
 
 }  // namespace deformlab

@@ -35,6 +35,15 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
+// The option "math", its error naming the pipeline.
+Math read_math(const std::string& name, const PipelineOptions& o) {
+  try {
+    return math_option(o);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(name + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align) {
@@ -69,7 +78,8 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
       m_(s.model),
       p_(s.params),
       rule_(info(s.integrator).rule),
-      sched_(make_schedule(s.integrator)) {
+      sched_(make_schedule(s.integrator)),
+      math_(read_math(name_, s.options)) {
   context();
   n_ = m_.node_count();
   if (n_ < 1) throw std::invalid_argument(name_ + ": the model has no nodes");
@@ -241,6 +251,7 @@ void GlPipeline::init() {
   const std::string common = "#define RULE " + std::to_string(int(rule_)) + "\n" +
                              (m_.grid() ? "#define TOPOLOGY_GRID 1\n" : "#define TOPOLOGY_GENERAL 1\n") +
                              "#define LINK_VIEW " + std::to_string(std::max<std::int64_t>(link_view_, 1)) + "\n" +
+                             (math_ == Math::exact ? "#define MATH_EXACT 1\n" : "#define MATH_FAST 1\n") +
                              (shared_ ? "#define EXTERNAL_FORCES 1\n" : "");
   for (GpuPass& g : passes_) {
     const int outputs = g.kind == PassKind::stage || rule_ == UpdateRule::verlet ? 3 : 2;

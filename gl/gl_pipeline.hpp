@@ -91,7 +91,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // With `shared`, the passes read accelerations that an outside force stage writes into
   // buffers it allocates, instead of evaluating forces. Options: "window", nodes per
   // storage-buffer window; "link_view", links per texture-buffer view of a general model's
-  // adjacency (default for both: the driver's limit).
+  // adjacency (default for both: the driver's limit); "math", exact or fast (core/pipeline.hpp).
   GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared = {});
   // Throws std::invalid_argument naming the driver's limit when `texels` texels do not fit
   // in one texture buffer.
@@ -100,8 +100,8 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   static void bind_nodes(GLuint index, const NodeBuffer& b, int first, int count);
   // Compiles the programs of the schedule's passes; call at the end of the subclass constructor.
   void init();
-  // `defines` selects the pass kind, its stage, the update rule and the neighbour mode (see
-  // shaders/sim.glsl); `outputs` values per node are written.
+  // `defines` selects the pass kind, its stage, the update rule, the neighbour mode and the
+  // math (see shaders/sim.glsl); `outputs` values per node are written.
   virtual Program make_program(int outputs, const std::string& defines) = 0;
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
@@ -146,6 +146,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   Params p_;
   const UpdateRule rule_;
   Schedule sched_;
+  const Math math_;
   std::vector<GpuPass> passes_;
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass

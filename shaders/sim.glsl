@@ -4,18 +4,34 @@
 // The including shader defines, before this file:
 //   vec4 src_x(int j), src_v(int j)  the state the forces are evaluated at (x.w: inverse mass)
 // and the host defines PASS (one of the PASS_* below), STAGE (the pass's stage, 0..3),
-// RULE (node_physics.h's RULE_*) and TOPOLOGY_GRID or TOPOLOGY_GENERAL.
+// RULE (node_physics.h's RULE_*), TOPOLOGY_GRID or TOPOLOGY_GENERAL, and MATH_EXACT or
+// MATH_FAST (the pipeline option "math": the CPU float pipeline's operations, see
+// exact_math.glsl, or what the driver makes of the plain ones).
 // With EXTERNAL_FORCES (the hybrid pipelines) another API's force pass wrote each node's
 // acceleration, which the including shader reads as vec4 forces_acc(int i).
 
 #define real float
 #define DL_FN
 #define CREF(T) T
-#define OUT(T) out T
-#define INOUT(T) inout T
+#define OUT(T) DL_PRECISE out T
+#define INOUT(T) DL_PRECISE inout T
 #define VEC3(a, b, c) vec3(a, b, c)
 #define DL_FINITE(a) ((floatBitsToUint(a) & 0x7f800000u) != 0x7f800000u)
 #define DL_INFINITY uintBitsToFloat(0x7f800000u)
+#if defined(MATH_EXACT)
+#include "exact_math.glsl"
+#define DL_PRECISE precise
+#define DL_RECIP(a) dl_recip(a)
+#define DL_DOT(a, b) dl_dot(a, b)
+#define DL_LENGTH(a) dl_length(a)
+#elif defined(MATH_FAST)
+#define DL_PRECISE
+#define DL_RECIP(a) (real(1) / (a))
+#define DL_DOT(a, b) dot(a, b)
+#define DL_LENGTH(a) length(a)
+#else
+#error the host defines MATH_EXACT or MATH_FAST
+#endif
 #include "node_physics.h"
 
 #define PASS_ONE 0     // one force pass and the step's result: o0 = x', o1 = (v', displacement), o2 = x (Verlet)
@@ -55,7 +71,7 @@ vec4 link(int e) {
 #endif
 
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
-  vec3 f = vec3(0.0);
+  DL_PRECISE vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
   int ci = i % params.nx, cj = (i / params.nx) % params.ny, ck = i / (params.nx * params.ny);
   for (int e = 0; e < params.stencil_count; ++e) {

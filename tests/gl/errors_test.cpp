@@ -1,5 +1,6 @@
 // Failures are reported where they happen: a broken shader with its name and the driver's
-// log (and a non-zero exit of the command), no EGL display with one clear error (exit 2).
+// log (and a non-zero exit of the command), no EGL display or a bad option value with one clear
+// error (exit 2).
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -82,6 +83,21 @@ TEST(GlErrors, UnknownGlDeviceIsBadInput) {
   std::filesystem::remove_all(dir);
   EXPECT_EQ(c.exit_code, 2) << c.output;
   EXPECT_NE(c.output.find("--gl-device 99 does not exist"), std::string::npos) << c.output;
+}
+
+// A pipeline option's bad value is bad input like the flags' (tests/unit/bad_input_test.cpp,
+// which runs without GL): one line, exit 2, nothing written.
+TEST(GlErrors, BadMathValueIsBadInput) {
+  DEFORMLAB_REQUIRE_GL();
+  for (const char* name : {"glsl-tf", "glsl-compute"}) {
+    const auto dir = temp_dir("math");
+    const Command c = run_deformlab(
+        "", std::string("run -p ") + name + " --grid 8x8 --steps 1 --option math=foo -o '" + (dir / "out").string() + "'");
+    EXPECT_EQ(c.exit_code, 2) << c.output;
+    EXPECT_EQ(c.output, std::string("deformlab: error: ") + name + ": option math 'foo' is not exact or fast\n");
+    EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
+    std::filesystem::remove_all(dir);
+  }
 }
 
 // The command end to end: frames every N steps and the final one, committed with the run.

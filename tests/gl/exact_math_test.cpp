@@ -1,0 +1,158 @@
+// The GL pipelines' option math: exact (the default) runs shaders/exact_math.glsl.
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gl/objects.hpp"
+#include "gl_test_support.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+// dl_recip and dl_sqrt of floats given by their bits, run in a compute shader whose driver
+// starting values are moved by `guess_ulps` (DL_GUESS_ULPS).
+class ExactMath {
+ public:
+  explicit ExactMath(int guess_ulps)
+      : prog_(gl::make_program_from_source(GL_COMPUTE_SHADER, "exact_math_test.comp", source(guess_ulps))) {}
+
+  // The results' bits, (1/x, sqrt(x)) for each x.
+  std::vector<std::uint32_t> run(const std::vector<std::uint32_t>& x) const {
+    constexpr std::size_t kChunk = std::size_t(1) << 20;
+    std::vector<std::uint32_t> out(2 * x.size());
+    glUseProgram(prog_.id());
+    for (std::size_t first = 0; first < x.size(); first += kChunk) {
+      const std::size_t n = std::min(kChunk, x.size() - first);
+      const gl::Buffer in = gl::make_buffer(n * 4, x.data() + first), res = gl::make_buffer(n * 8);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, res.id());
+      glUniform1ui(0, GLuint(n));
+      glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      gl::read_buffer(res.id(), 0, n * 8, out.data() + 2 * first);
+    }
+    glUseProgram(0);
+    return out;
+  }
+
+ private:
+  static std::string source(int guess_ulps) {
+    return "#version 430 core\n#define DL_GUESS_ULPS " + std::to_string(guess_ulps) + "\n" +
+           gl::shader_file("exact_math.glsl") + R"(
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer In { uint x_bits[]; };
+layout(std430, binding = 1) writeonly buffer Out { uvec2 results[]; };
+layout(location = 0) uniform uint u_n;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i < u_n) {
+    float x = uintBitsToFloat(x_bits[i]);
+    results[i] = uvec2(floatBitsToUint(dl_recip(x)), floatBitsToUint(dl_sqrt(x)));
+  }
+}
+)";
+  }
+  gl::Program prog_;
+};
+
+std::string hex(float f) {
+  char s[48];
+  std::snprintf(s, sizeof s, "%a (0x%08x)", double(f), std::bit_cast<std::uint32_t>(f));
+  return s;
+}
+
+// Every float's result equal to the CPU's correctly rounded 1.0f / x and std::sqrt(x) bit for
+// bit (a NaN to any NaN); the first few differences are named.
+void expect_correctly_rounded(const ExactMath& em, const std::vector<std::uint32_t>& xs, const std::string& what) {
+  const std::vector<std::uint32_t> r = em.run(xs);
+  std::size_t wrong = 0;
+  auto check = [&](const char* op, float x, std::uint32_t got, float want) {
+    if (std::isnan(want) ? std::isnan(std::bit_cast<float>(got)) : got == std::bit_cast<std::uint32_t>(want)) return;
+    if (wrong++ < 5) ADD_FAILURE() << what << ": " << op << "(" << hex(x) << ") = " << hex(std::bit_cast<float>(got))
+                                   << ", correctly rounded " << hex(want);
+  };
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    const float x = std::bit_cast<float>(xs[k]);
+    check("recip", x, r[2 * k], 1.0f / x);
+    check("sqrt", x, r[2 * k + 1], std::sqrt(x));
+  }
+  EXPECT_EQ(wrong, 0u) << what << ": results not correctly rounded, of " << xs.size() << " floats";
+}
+
+// Both signs of: zeros, infinities, NaNs, subnormals, every power of two and its neighbours,
+// floats near 1, 2 and 4, the smallest and largest normals, and those whose 1/x is subnormal.
+std::vector<std::uint32_t> edge_cases() {
+  std::vector<std::uint32_t> v = {0x00000000, 0x7f800000, 0x7fc00000, 0x7f800001, 0x00000001, 0x00000002,
+                                  0x00000003, 0x000003ff, 0x00400000, 0x00400001, 0x007fffff, 0x00800000,
+                                  0x00800001, 0x00ffffff, 0x7f7fffff, 0x7f7ffffe, 0x7e800001, 0x7effffff};
+  for (std::uint32_t e = 1; e < 255; ++e)
+    for (std::uint32_t d : {0u, 1u, 2u, 0x7fffffu, 0x7ffffeu}) v.push_back((e << 23) + d);
+  for (std::uint32_t base : {0x3f800000u, 0x40000000u, 0x40800000u})
+    for (std::uint32_t d = 0; d < 64; ++d) v.insert(v.end(), {base + d, base - 1 - d});
+  for (std::uint32_t d = 0; d < 4096; ++d) v.push_back(0x7e800000u + d * 0x1fffu);  // [2^126, 2^128)
+  for (std::size_t k = 0, n = v.size(); k < n; ++k) v.push_back(v[k] | 0x80000000u);
+  return v;
+}
+
+std::vector<std::uint32_t> random_bits(std::size_t n, std::uint32_t lo, std::uint32_t hi, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::uint32_t> d(lo, hi);
+  std::vector<std::uint32_t> v(n);
+  for (auto& b : v) b = d(rng);
+  return v;
+}
+
+// dl_recip and dl_sqrt are correctly rounded: bit for bit the CPU's 1.0f / x and std::sqrt(x)
+// on every float in [1, 4) (every significand with both exponent parities: the functions reduce
+// their argument to there by its bits), on the edge cases, and on random bit patterns (every
+// exponent and sign, subnormals and NaNs). Again on the edge cases and samples with the
+// driver's starting values moved by 3 ulp (past GLSL's 2.5 for 1/x) and by 24 ulp (the method
+// takes them within 32), which must not change a bit: llvmpipe's 1/x and sqrt are correctly
+// rounded already, a GPU's are not.
+TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
+  DEFORMLAB_REQUIRE_GL();
+  gl::context();
+  const ExactMath driver(0);
+  std::vector<std::uint32_t> one_to_four(0x40800000u - 0x3f800000u);
+  for (std::uint32_t k = 0; k < one_to_four.size(); ++k) one_to_four[k] = 0x3f800000u + k;
+  expect_correctly_rounded(driver, one_to_four, "[1, 4)");
+  expect_correctly_rounded(driver, edge_cases(), "edge cases");
+  expect_correctly_rounded(driver, random_bits(std::size_t(1) << 20, 0u, 0xffffffffu, 1), "random bits");
+  for (int ulps : {-24, -3, 3, 24}) {
+    const ExactMath moved(ulps);
+    const std::string what = "starting values moved by " + std::to_string(ulps) + " ulp, ";
+    expect_correctly_rounded(moved, edge_cases(), what + "edge cases");
+    expect_correctly_rounded(moved, random_bits(std::size_t(1) << 18, 0x3f800000u, 0x407fffffu, 2), what + "[1, 4)");
+    expect_correctly_rounded(moved, random_bits(std::size_t(1) << 18, 0u, 0xffffffffu, 3), what + "random bits");
+  }
+  gl::check("exact math test");
+}
+
+// math=exact is the default (the same bits as without the option); a value other than exact
+// or fast is refused naming the pipeline.
+TEST(MathOption, ExactIsTheDefaultAndOtherValuesAreRefused) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(9, 7);
+  const Params p = small_params();
+  const State s0 = perturbed_state(m, 5);
+  for (const char* name : {"glsl-tf", "glsl-compute"}) {
+    auto plain = make_gl(name, {m, p, Integrator::rk4});
+    auto exact = make_gl(name, {m, p, Integrator::rk4, {{"math", "exact"}}});
+    EXPECT_TRUE(bitwise_equal(advance(*plain, s0, 5), advance(*exact, s0, 5))) << name;
+    try {
+      make_gl(name, {m, p, Integrator::rk4, {{"math", "precise"}}});
+      ADD_FAILURE() << name << " accepted math=precise";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), std::string(name) + ": option math 'precise' is not exact or fast");
+    }
+  }
+}
+
+}  // namespace
+}  // namespace deformlab::test
