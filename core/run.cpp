@@ -92,8 +92,8 @@ class StepTimes {
 
 }  // namespace
 
-std::string divergence(double disp, const Model& m, const Params& p, Integrator i, int step, double t) {
-  const double runaway = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t) {
+  const double runaway = double(p.runaway_factor) * std::max(double(extent), 1e-3);
   if (std::isfinite(disp) && disp <= runaway) return {};
   std::ostringstream os;
   os << "diverged at step " << step << " (t = " << t << " s): ";
@@ -110,6 +110,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
   RunResult r;
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
+  const float extent = m.extent();
   pipe.set_profiler(opt.profiler);
   StepTimes times(pipe, r, opt.profiler);
   const auto start = clock::now();
@@ -131,7 +132,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
       HostSpan span(opt.profiler, span::reductions);
       disp = pipe.max_displacement();
       r.last_displacement = disp;
-      if (const std::string why = divergence(disp, m, p, opt.integrator, step, t); !why.empty())
+      if (const std::string why = divergence(disp, extent, m, p, opt.integrator, step, t); !why.empty())
         throw DivergenceError(step, why);
     }
     r.records.push_back({step, t, std::numeric_limits<double>::quiet_NaN(), queue_ms, disp});

@@ -26,8 +26,9 @@ double stability_limit(const Model& m, const Params& p, Integrator i);
 std::string stability_hint(const Model& m, const Params& p, Integrator i);
 
 // Empty when a step's largest displacement `disp` (Pipeline::max_displacement) is finite and
-// below the runaway limit, else the message naming the step, what was seen and the bound.
-std::string divergence(double disp, const Model& m, const Params& p, Integrator i, int step, double t);
+// below the runaway limit (runaway_factor x `extent`, the model's Model::extent(), which walks
+// every node: callers take it once), else the message naming the step, what was seen and the bound.
+std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t);
 
 class DivergenceError : public std::runtime_error {
  public:

@@ -26,7 +26,6 @@
 #include "core/partition.hpp"
 #include "core/stage.hpp"
 #include "core/step_params.hpp"
-#include "fused_cloth.cuh"
 #include "kernels.cuh"
 #include "temporal.cuh"
 #include "math_builds.hpp"
@@ -328,10 +327,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
     if (o_.variant == Variant::temporal) plan_temporal();
-    if (fused_ && m.grid() && !m.volume()) {
-      check_fused_cloth_tile();
-      ForceKernels::upload(halo_, halo_springs(o_.tile), "uploading the halo's springs");
-    }
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
@@ -623,18 +618,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
                                                                    has_prev_, xo, vo, tg,
                                                                    stop_check(blocks_for(n_), kBlock));
       check_launch("launching the fused CSR step kernel");
-    } else if (!model_.volume()) {
-      with_grid_flags([&](auto, auto damped) {
-        const auto kernel = dev::fused_cloth<damped(), Rule>;
-        const std::size_t shared = fused_cloth_shared();
-        if (shared > 48 * 1024)
-          check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
-                "raising the fused kernel's shared-memory limit");
-        const dev::HaloSprings halo{halo_.get(), int(halo_.size())};
-        kernel<<<grid_blocks(), grid_threads(), shared, stream_>>>(sp_, stencil_, w, halo, x, v, xp, has_prev_, xo, vo,
-                                                                   tg, stop_check(grid_blocks(), grid_threads()));
-      });
-      check_launch("launching the fused cloth step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
@@ -643,39 +626,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       });
       check_launch("launching the fused step kernel");
     }
-  }
-
-  // The springs of a tile's halo that reach into it (dev::HaloSprings): own entry e of halo
-  // cell (a, b) whose other end is in the tile.
-  static std::vector<int> halo_springs(const Tile& t) {
-    std::vector<int> out;
-    for (int e = 0; e < dev::kOwnSprings; ++e) {
-      const GridOffset o = grid_offset(false, dev::kOwnSprings + e);
-      for (int b = -dev::kHalo; b < t.y; ++b)
-        for (int a = -dev::kHalo; a <= t.x; ++a) {
-          const bool in = a >= 0 && a < t.x && b >= 0 && b < t.y;
-          const int fa = a + o.di, fb = b + o.dj;
-          if (!in && fa >= 0 && fa < t.x && fb >= 0 && fb < t.y) out.push_back(e | (a + 2) << 3 | (b + 2) << 15);
-        }
-    }
-    return out;
-  }
-  // cuda-fused on a cloth (dev::fused_cloth): the block's state with its halo and the force cells.
-  std::size_t fused_cloth_shared() const {
-    const int tx = o_.tile.x, ty = o_.tile.y;
-    return sizeof(float4) * (std::size_t(tx + 2 * dev::kHalo) * (ty + 2 * dev::kHalo) * (damped_ ? 2 : 1) +
-                             std::size_t(dev::kOwnSprings) * (tx + 3) * (ty + 2));
-  }
-  void check_fused_cloth_tile() const {
-    int device = 0, limit = 0;
-    check(cudaGetDevice(&device), "finding the device");
-    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
-          "reading the shared-memory limit");
-    if (fused_cloth_shared() > std::size_t(limit))
-      throw std::invalid_argument("cuda-fused: a tile of " + std::to_string(o_.tile.x) + "x" +
-                                  std::to_string(o_.tile.y) + " needs " + std::to_string(fused_cloth_shared()) +
-                                  " bytes of shared memory on a cloth; this device allows " + std::to_string(limit) +
-                                  " a block (choose a smaller tile)");
   }
 
   // Verlet's previous positions of state c: the other ping-pong buffer, or (cuda-temporal,
@@ -804,8 +754,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
-  Buffer<float4> prev_[2];
-  Buffer<int> halo_;  // cuda-fused on cloths: the tile's halo springs (dev::HaloSprings)  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
+  Buffer<float4> prev_[2];  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
   Buffer<unsigned> warp_max_, stop_max_;  // the stop rule's warp maxima (dev::StopCheck), their largest
   Buffer<unsigned char> reduce_temp_;
   std::int64_t stop_warps_ = 0;  // of the last step's launch

@@ -58,12 +58,12 @@ fi
 # (bench), Nsight Compute's view of the fused and temporal kernels on the paper's scene at
 # 2048^2, and cuda-temporal timed by run, by its experiment cell and by the bench.
 if part speed; then
-  "$bench" cuda --sizes 2048 --variants fused --integrator explicit-euler --graph-sizes 64 --tiles 16x8 \
+  "$bench" cuda --sizes 2048 --variants fused --integrator explicit-euler --graph-sizes 64 --tiles 16x8 32x8 32x16 64x4 \
     --temporal-sizes 2048 8192 --csv "$out/speed-bench.csv" >"$out/speed-bench.txt" 2>&1
   if command -v ncu >/dev/null; then
     for math in exact fast; do
       for integ in explicit-euler semi-implicit-euler verlet; do
-        ncu --kernel-name regex:fused_grid --launch-skip 20 --launch-count 1 --section SpeedOfLight \
+        ncu --kernel-name regex:fused_ --launch-skip 20 --launch-count 1 --section SpeedOfLight \
           --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis --section InstructionStats \
           --section WarpStateStats --section Occupancy --section LaunchStats \
           "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-fused --integrator "$integ" \

@@ -7,7 +7,8 @@
 
 namespace deformlab::viewer {
 
-Session::Session(SessionSetup s) : s_(std::move(s)), scene_inv_mass_(s_.model.inv_mass), handle_(s_.params.drag) {
+Session::Session(SessionSetup s)
+    : s_(std::move(s)), scene_inv_mass_(s_.model.inv_mass), extent_(s_.model.extent()), handle_(s_.params.drag) {
   pipe_ = make(*s_.entry, s_.integrator, s_.options, s_.params);
 }
 
@@ -53,7 +54,7 @@ double Session::step(int n, StepTimer* timer, Profiler* prof) {
   steps_ += n;
   time_ += n * double(s_.params.dt);
   const double disp = pipe_->max_displacement();
-  if (const std::string why = divergence(disp, s_.model, s_.params, s_.integrator, steps_, time_); !why.empty())
+  if (const std::string why = divergence(disp, extent_, s_.model, s_.params, s_.integrator, steps_, time_); !why.empty())
     throw DivergenceError(steps_, why);
   return disp;
 }

@@ -61,6 +61,7 @@ class Session {
 
   SessionSetup s_;
   std::vector<float> scene_inv_mass_;  // the scene's, for freeing and reset
+  float extent_;                       // the model's (divergence's bound)
   std::unique_ptr<Pipeline> pipe_;
   DragHandle handle_;  // the pipeline's: the scene's until picking replaces it
   int steps_ = 0, dragged_ = -1;

@@ -9,7 +9,7 @@ namespace {
 
 TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   const PipelineRegistry& r = pipelines();
-  for (const char* n : {"cpu", "omp", "cuda-naive", "cuda-tiled", "cuda-fused"})
+  for (const char* n : {"cpu", "omp", "cuda-naive", "cuda-tiled", "cuda-fused", "cuda-temporal"})
     EXPECT_EQ(r.find(n)->traits.cpu_match, CpuMatch::bitwise) << n;
   for (const char* n : {"reference", "cuda-scatter", "glsl-tf", "glsl-compute", "hybrid", "hybrid-compute"})
     EXPECT_EQ(r.find(n)->traits.cpu_match, CpuMatch::rounding) << n;
@@ -18,8 +18,14 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_EQ(r.find("hybrid")->traits.update, Engine::gl_transform_feedback);
   EXPECT_EQ(r.find("hybrid-compute")->traits.update, Engine::gl_compute);
   EXPECT_EQ(r.find("cpu")->traits.force, Engine::cpu);
-  EXPECT_EQ(r.find("cuda-tiled")->options, std::vector<std::string>{"tile"});
-  EXPECT_EQ(r.find("hybrid")->options, (std::vector<std::string>{"interop", "force", "tile"}));
+  EXPECT_EQ(r.find("cuda-tiled")->options, (std::vector<std::string>{"tile", "math"}));
+  EXPECT_EQ(r.find("cuda-temporal")->options, (std::vector<std::string>{"tile", "steps_per_launch", "math"}));
+  EXPECT_EQ(r.find("hybrid")->options, (std::vector<std::string>{"interop", "force", "tile", "math"}));
+  for (const auto& e : r.all()) EXPECT_EQ(e.traits.grids_only, e.name == "cuda-temporal") << e.name;
+  // Fast math compares by rounding; exact keeps the trait.
+  EXPECT_EQ(cpu_match(*r.find("cuda-fused"), {{"math", "fast"}}), CpuMatch::rounding);
+  EXPECT_EQ(cpu_match(*r.find("cuda-fused"), {{"math", "exact"}}), CpuMatch::bitwise);
+  EXPECT_THROW(math_option({{"math", "quick"}}), std::invalid_argument);
 }
 
 // The check before a run adds the model, the pipeline's own host bytes and a state, and names
