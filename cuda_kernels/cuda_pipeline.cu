@@ -567,11 +567,12 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
   }
 
-  // Runs `launch`, timed as a span named `name` when a profiler is attached.
+  // Runs `launch`, timed as a span named `name` when a profiler is attached (of `steps` steps:
+  // EventSpans::begin).
   template <class F>
-  void timed(const char* name, F&& launch) {
+  void timed(const char* name, F&& launch, int steps = 1) {
     if (!prof_) return launch();
-    spans_.begin(*prof_, name, stream_);
+    spans_.begin(*prof_, name, stream_, steps);
     launch();
     spans_.end(stream_);
     if (spans_.pending() > 1024) spans_.collect(prof_);
@@ -689,7 +690,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
         case UpdateRule::verlet: return launch_temporal<RULE_VERLET>();
         case UpdateRule::backward_euler: throw std::logic_error("cuda-temporal step for backward Euler");
       }
-    });
+    }, pending_);
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
     launched_ += pending_;

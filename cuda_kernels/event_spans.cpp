@@ -49,8 +49,8 @@ std::vector<double> EventTimer::take() {
   return std::exchange(done_, {});
 }
 
-void EventSpans::begin(const Profiler& p, const char* name, CUstream_st* s) {
-  pending_.push_back({name, p.step(), p.now_ms()});
+void EventSpans::begin(const Profiler& p, const char* name, CUstream_st* s, int steps) {
+  pending_.push_back({name, p.step(), p.now_ms(), steps});
   range_.emplace(name);
   timer_.begin(s);
 }
@@ -62,8 +62,11 @@ void EventSpans::end(CUstream_st* s) {
 
 void EventSpans::collect(Profiler* p) {
   const std::vector<double> ms = timer_.take();
-  for (std::size_t k = 0; k < pending_.size(); ++k)
-    if (p) p->add({pending_[k].name, pending_[k].step, pending_[k].start_ms, ms[k], "CUDA events"});
+  for (std::size_t k = 0; k < pending_.size() && p; ++k) {
+    const Pending& s = pending_[k];
+    for (int q = 0; q < s.steps; ++q)
+      p->add({s.name, s.step - s.steps + 1 + q, s.start_ms, ms[k] / s.steps, "CUDA events"});
+  }
   pending_.clear();
 }
 

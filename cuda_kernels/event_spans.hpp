@@ -36,7 +36,9 @@ class EventSpans {
  public:
   // A span of the work queued on `s` between begin and end, at the profiler's current step
   // and host time, with an NVTX range of the same name over the host side. Spans may not nest.
-  void begin(const Profiler& p, const char* name, CUstream_st* s);
+  // Work for `steps` steps (cuda-temporal's launch: the current step and those before it)
+  // gives each of them an equal share.
+  void begin(const Profiler& p, const char* name, CUstream_st* s, int steps = 1);
   void end(CUstream_st* s);
   // Waits for the work of the pending spans and adds them to `p` (null: drops them).
   void collect(Profiler* p);
@@ -47,6 +49,7 @@ class EventSpans {
     const char* name;
     int step;
     double start_ms;
+    int steps;
   };
   EventTimer timer_;
   std::vector<Pending> pending_;

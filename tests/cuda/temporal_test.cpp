@@ -142,6 +142,30 @@ TEST(CudaTemporal, EveryStepIsTimed) {
   EXPECT_EQ(ms[8], ms[9]);
 }
 
+// A profiled launch gives each of its steps an equal share: one force+update span a step.
+TEST(CudaTemporal, EachStepGetsItsShareOfALaunchsSpan) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model m = small_cloth(64, 64);
+  auto t = cuda::make_pipeline({m, small_params(), Integrator::semi_implicit_euler}, temporal(4, {}, Math::exact));
+  Profiler prof;
+  t->set_state(rest_state(m));
+  t->set_profiler(&prof);
+  for (int k = 1; k <= 10; ++k) {  // launches after steps 4 and 8; steps 9 and 10 go when read
+    prof.set_step(k);
+    t->step();
+  }
+  t->max_displacement();
+  t->set_profiler(nullptr);
+  std::vector<int> steps;
+  for (const Span& s : prof.spans()) {
+    EXPECT_EQ(s.name, "force+update");
+    EXPECT_GT(s.ms, 0.0);
+    steps.push_back(s.step);
+  }
+  EXPECT_EQ(steps, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(prof.spans()[0].ms, prof.spans()[3].ms);
+}
+
 TEST(CudaTemporal, RefusesWhatItDoesNotRun) {
   DEFORMLAB_REQUIRE_CUDA();
   const Params p = small_params();
