@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,16 @@ class Pipeline {
   // Largest node displacement |x_{n+1} - x_n| of the last step, computed where the state
   // lives; NaN when any position or velocity is not finite.
   virtual double max_displacement() = 0;
+  // Checks that do not hold the device up. A pipeline that keeps the state from before its last
+  // step can take that step back (once, until the next step); the run loop then checks step n
+  // while step n + 1 runs and takes n + 1 back when n met the stop rule. queue_displacement()
+  // queues the read of the last step's max_displacement() and returns at once;
+  // take_displacement() waits for the oldest one queued (two at most). Pipelines that cannot
+  // step back need not queue: the run waits at each check.
+  virtual bool can_step_back() const { return false; }
+  virtual void step_back() { throw std::logic_error("this pipeline cannot take a step back"); }
+  virtual void queue_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
+  virtual double take_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
   // A timer of this pipeline's steps on the clock of the device that runs them (valid while
   // the pipeline lives). The default: the host clock, for pipelines that step on the host.
   virtual std::unique_ptr<StepTimer> step_timer() { return std::make_unique<HostStepTimer>(); }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "springs.hpp"
 
@@ -72,7 +73,7 @@ class StepTimes {
   }
   void fill() {
     const std::vector<double> ms = timer_->take();
-    for (std::size_t k = 0; k < ms.size(); ++k, ++filled_) {
+    for (std::size_t k = 0; k < ms.size() && filled_ < r_.records.size(); ++k, ++filled_) {
       StepRecord& rec = r_.records[filled_];
       rec.ms = ms[k];
       r_.total_ms += ms[k];
@@ -80,6 +81,9 @@ class StepTimes {
     }
     start_ms_.clear();
   }
+  // Removes the last step's record before its time is read: the run took that step back
+  // (fill() leaves the timer's time of it unread).
+  void drop_last() { r_.records.pop_back(); }
 
  private:
   static constexpr std::size_t kBatch = 1024;
@@ -111,6 +115,19 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   const float extent = m.extent();
+  // A check waits for its step only where the pipeline cannot step back or each step is
+  // looked at (after_step); else it is read while the next step runs (Pipeline::step_back).
+  const bool lagged = pipe.can_step_back() && !opt.after_step;
+  int queued = 0;  // the step whose check is queued (lagged), else 0
+  // Records a checked step's displacement; true when the run stops there.
+  auto stops_at = [&](int step, double disp) {
+    const double t = step * double(p.dt);
+    r.records[std::size_t(step - 1)].max_displacement = disp;
+    r.last_displacement = disp;
+    if (const std::string why = divergence(disp, extent, m, p, opt.integrator, step, t); !why.empty())
+      throw DivergenceError(step, why);
+    return opt.until_converged && step >= p.min_steps && t >= drag_end && disp < p.threshold;
+  };
   pipe.set_profiler(opt.profiler);
   StepTimes times(pipe, r, opt.profiler);
   const auto start = clock::now();
@@ -124,21 +141,39 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     }
     times.end();
     const double queue_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
-    const double t = step * double(p.dt);
     r.steps = step;
-    double disp = std::numeric_limits<double>::quiet_NaN();
-    const bool check = step % p.check_every == 0 || step == p.max_steps;
-    if (check) {
-      HostSpan span(opt.profiler, span::reductions);
-      disp = pipe.max_displacement();
-      r.last_displacement = disp;
-      if (const std::string why = divergence(disp, extent, m, p, opt.integrator, step, t); !why.empty())
-        throw DivergenceError(step, why);
+    r.records.push_back({step, step * double(p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
+                         std::numeric_limits<double>::quiet_NaN()});
+    if (queued) {  // the previous step's check, read while this step runs
+      const int checked = std::exchange(queued, 0);
+      bool met = false;
+      try {
+        HostSpan span(opt.profiler, span::reductions);
+        met = stops_at(checked, pipe.take_displacement());
+      } catch (const DivergenceError&) {
+        pipe.step_back();
+        throw;
+      }
+      if (met) {
+        pipe.step_back();
+        times.drop_last();
+        r.steps = checked;
+        r.converged = true;
+        break;
+      }
     }
-    r.records.push_back({step, t, std::numeric_limits<double>::quiet_NaN(), queue_ms, disp});
+    const bool check = step % p.check_every == 0 || step == p.max_steps;
+    bool stop = false;
+    if (check && lagged && step < p.max_steps) {
+      pipe.queue_displacement();
+      queued = step;
+    } else if (check) {
+      HostSpan span(opt.profiler, span::reductions);
+      stop = stops_at(step, pipe.max_displacement());
+    }
     times.after_step();
     if (opt.after_step) opt.after_step(step);
-    if (opt.until_converged && check && step >= p.min_steps && t >= drag_end && disp < p.threshold) {
+    if (stop) {
       r.converged = true;
       break;
     }

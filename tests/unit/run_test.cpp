@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <utility>
 
 #include "core/cpu_backend.hpp"
 #include "core/run.hpp"
@@ -147,6 +151,114 @@ TEST(Run, CheckEveryKStepsStillCatchesDivergence) {
   } catch (const DivergenceError& e) {
     EXPECT_EQ(e.step % 8, 0);
   }
+}
+
+// A CPU pipeline that can take its last step back, as the GPU pipelines do: the lagged
+// checks must give the run the same end as checks that wait.
+class SteppingBack final : public Pipeline {
+ public:
+  SteppingBack(std::unique_ptr<Pipeline> p, bool can) : p_(std::move(p)), can_(can) {}
+  void set_state(const State& s) override { p_->set_state(s); }
+  State state() override { return p_->state(); }
+  void step() override {
+    before_ = p_->state();
+    p_->step();
+  }
+  void set_drag(const DragHandle& d) override { p_->set_drag(d); }
+  double max_displacement() override { return p_->max_displacement(); }
+  bool can_step_back() const override { return can_; }
+  void step_back() override {
+    ASSERT_TRUE(before_.has_value()) << "step taken back twice";
+    p_->set_state(*std::exchange(before_, std::nullopt));
+    ++taken_back;
+  }
+  void queue_displacement() override {
+    queued_.push_back(p_->max_displacement());
+    ++queues;
+  }
+  double take_displacement() override {
+    const double d = queued_.front();
+    queued_.pop_front();
+    return d;
+  }
+  int queues = 0, taken_back = 0;
+
+ private:
+  std::unique_ptr<Pipeline> p_;
+  bool can_;
+  std::optional<State> before_;
+  std::deque<double> queued_;
+};
+
+struct Ended {
+  RunResult r;
+  State s;
+  int diverged_at = 0, queues = 0, taken_back = 0;
+};
+
+Ended run_checked(const Model& m, const Params& p, Integrator i, bool can_step_back) {
+  SteppingBack pipe(make_cpu_pipeline({m, p, i}, Precision::f32, false), can_step_back);
+  Ended e;
+  try {
+    e.r = run(pipe, m, p, {.until_converged = true, .integrator = i});
+  } catch (const DivergenceError& err) {
+    e.diverged_at = err.step;
+  }
+  e.s = pipe.state();
+  e.queues = pipe.queues;
+  e.taken_back = pipe.taken_back;
+  return e;
+}
+
+void expect_same_end(const Ended& lagged, const Ended& waited) {
+  EXPECT_GT(lagged.queues, 0);
+  EXPECT_EQ(waited.queues, 0);
+  EXPECT_EQ(lagged.diverged_at, waited.diverged_at);
+  EXPECT_EQ(lagged.r.steps, waited.r.steps);
+  EXPECT_EQ(lagged.r.converged, waited.r.converged);
+  EXPECT_EQ(lagged.r.last_displacement, waited.r.last_displacement);
+  EXPECT_EQ(lagged.s.t, waited.s.t);
+  EXPECT_EQ(test::max_position_diff(lagged.s, waited.s), 0.0);
+  EXPECT_EQ(test::max_diff(lagged.s.v, waited.s.v), 0.0);
+  ASSERT_EQ(lagged.r.records.size(), waited.r.records.size());
+  for (std::size_t k = 0; k < lagged.r.records.size(); ++k) {
+    const double a = lagged.r.records[k].max_displacement, b = waited.r.records[k].max_displacement;
+    EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << "step " << k + 1 << ": " << a << " vs " << b;
+  }
+}
+
+TEST(Run, LaggedChecksEndWhereWaitingChecksEnd) {
+  const Model m = test::small_cloth(12, 12);
+  Params p = test::small_params();
+  p.damping = 0.5f;
+  p.threshold = 1e-5f;
+  p.max_steps = 50000;
+  p.min_steps = 50;
+  for (int every : {1, 3}) {
+    p.check_every = every;
+    const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true);
+    const Ended waited = run_checked(m, p, Integrator::semi_implicit_euler, false);
+    ASSERT_TRUE(waited.r.converged) << "every " << every;
+    EXPECT_EQ(lagged.taken_back, 1) << "every " << every;  // the step queued after the stop
+    expect_same_end(lagged, waited);
+  }
+  p.max_steps = 40;  // the budget ends it before the rule: nothing to take back
+  const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true);
+  EXPECT_EQ(lagged.taken_back, 0);
+  EXPECT_EQ(lagged.r.steps, 40);
+  expect_same_end(lagged, run_checked(m, p, Integrator::semi_implicit_euler, false));
+}
+
+TEST(Run, LaggedChecksCatchDivergenceAtTheSameStep) {
+  const Model m = test::small_cloth(10, 10);
+  Params p = test::small_params();
+  p.dt = float(3 * stability_limit(m, p, Integrator::semi_implicit_euler));
+  p.max_steps = 5000;
+  const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true);
+  const Ended waited = run_checked(m, p, Integrator::semi_implicit_euler, false);
+  ASSERT_GT(waited.diverged_at, 0);
+  EXPECT_EQ(lagged.taken_back, 1);
+  expect_same_end(lagged, waited);
 }
 
 }  // namespace
