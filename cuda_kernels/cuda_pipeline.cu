@@ -2,7 +2,6 @@
 // and the device reductions (displacement, energy); and its force pass on its own, the CUDA
 // stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels. It is
 // compiled once per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
-#include <cub/device/device_reduce.cuh>
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -340,14 +339,12 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
     if (temporal_ && sched_.rule == UpdateRule::verlet)
       for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
-    warp_max_.allocate(std::max({warps_of(dim3(blocks_for(n_)), dim3(kBlock)), warps_of(grid_blocks(), grid_threads()),
-                                 temporal_ ? warps_of(temporal_blocks(), dim3(dev::kTemporalThreads)) : 0}),
-                       "allocating the stop rule's warp maxima");
-    stop_max_.allocate(1, "allocating the largest displacement");
-    std::size_t bytes = 0;
-    check(cub::DeviceReduce::Max(nullptr, bytes, warp_max_.get(), stop_max_.get(), std::int64_t(warp_max_.size())),
-          "sizing the displacement reduction");
-    reduce_temp_.allocate(bytes, "allocating the displacement reduction");
+    stop_.allocate(2, "allocating the largest displacement");
+    void* h = nullptr;
+    check(cudaMallocHost(&h, kQueued * sizeof(unsigned)), "allocating the displacement read-back");
+    disp_host_.reset(static_cast<unsigned*>(h));
+    for (cudaEvent_t& e : disp_read_)
+      check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "creating a read-back event");
 
     set_state(rest_state(m));
   }
@@ -355,6 +352,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   ~Impl() override {
     drop_graphs();
     if (copied_) cudaEventDestroy(copied_);
+    for (cudaEvent_t e : disp_read_)
+      if (e) cudaEventDestroy(e);
     if (stream_) cudaStreamDestroy(stream_);
   }
 
@@ -364,12 +363,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       throw std::invalid_argument("state size does not match the model");
     cur_ = 0;
     pending_ = 0;
+    queued_ = 0;
+    check(cudaMemsetAsync(stop_.get(), 0, 2 * sizeof(unsigned), stream_), "clearing the largest displacement");
     upload_positions(x_[0], s.x);
     upload_vectors(v_[0], s.v);
     has_prev_ = !s.x_prev.empty();
     if (has_prev_) upload_positions(prev_x(0), s.x_prev);
     t_ = s.t;
     stepped_ = false;
+    back_ = Back::none;
   }
 
   State state() override {
@@ -410,27 +412,55 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       enqueue_step();
     }
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
+    back_t_ = t_;
+    back_ = Back::possible;
     cur_ = 1 - cur_;
     t_ += p_.dt;
     stepped_ = true;
     ++launched_;
   }
 
-  // The largest of the last step's warp maxima (dev::StopCheck): one small reduction and a
-  // word read back.
-  double max_displacement() override {
+  // The one-step kernels read state cur_ and write the other; Verlet's overwrite the positions
+  // before it, cuda-temporal's advance k steps.
+  bool can_step_back() const override { return !temporal_ && sched_.rule != UpdateRule::verlet; }
+  void step_back() override {
+    if (!can_step_back() || back_ != Back::possible) throw std::logic_error("cuda pipeline: no step to take back");
+    cur_ = 1 - cur_;
+    t_ = back_t_;
+    back_ = Back::taken;
+    // The step taken back added into the word the next step from this state adds into.
+    check(cudaMemsetAsync(stop_.get() + cur_, 0, sizeof(unsigned), stream_), "clearing the largest displacement");
+  }
+
+  // The last step's launch reduced its displacement into a word (dev::StopCheck): a read-back.
+  void queue_displacement() override {
     flush();
-    if (!stepped_) return 0.0;
-    std::size_t bytes = reduce_temp_.size();
-    check(cub::DeviceReduce::Max(reduce_temp_.get(), bytes, warp_max_.get(), stop_max_.get(), stop_warps_, stream_),
-          "reducing the largest displacement");
-    unsigned* h = reinterpret_cast<unsigned*>(staging());
-    check(cudaMemcpyAsync(h, stop_max_.get(), sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
-          "reading the largest displacement");
-    check(cudaStreamSynchronize(stream_), "reducing the largest displacement");
+    if (back_ == Back::taken) throw std::logic_error("the displacement before a step taken back is not kept");
+    if (queued_ == kQueued) throw std::logic_error("more displacement reads queued than taken");
+    const int q = (head_ + queued_++) % kQueued;
+    if (stepped_)
+      check(cudaMemcpyAsync(disp_host_.get() + q, stop_.get() + (1 - cur_), sizeof(unsigned), cudaMemcpyDeviceToHost,
+                            stream_),
+            "reading the largest displacement");
+    else
+      disp_host_.get()[q] = 0u;
+    check(cudaEventRecord(disp_read_[q], stream_), "marking the displacement read");
+  }
+  double take_displacement() override {
+    if (queued_ == 0) throw std::logic_error("no displacement read queued");
+    const int q = head_;
+    head_ = (head_ + 1) % kQueued;
+    --queued_;
+    check(cudaEventSynchronize(disp_read_[q]), "reducing the largest displacement");
     float d = 0.f;
-    std::memcpy(&d, h, sizeof d);
+    std::memcpy(&d, disp_host_.get() + q, sizeof d);
     return std::isinf(d) ? std::numeric_limits<double>::quiet_NaN() : double(d);
+  }
+  double max_displacement() override {
+    queue_displacement();
+    double d = 0.0;
+    while (queued_ > 0) d = take_displacement();
+    return d;
   }
 
   Energy energy() override {
@@ -612,18 +642,18 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const Targets tg = targets();
     if (!fused) {
       dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), xp, has_prev_, xo, vo,
-                                                                tg.end, stop_check(blocks_for(n_), kBlock));
+                                                                tg.end, stop_check());
       check_launch("launching the update kernel");
     } else if (!model_.grid()) {
       dev::fused_csr<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp,
                                                                    has_prev_, xo, vo, tg,
-                                                                   stop_check(blocks_for(n_), kBlock));
+                                                                   stop_check());
       check_launch("launching the fused CSR step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
             <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg,
-                                                            stop_check(grid_blocks(), grid_threads()));
+                                                            stop_check());
       });
       check_launch("launching the fused step kernel");
     }
@@ -646,6 +676,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     check(cudaGetDevice(&device), "finding the device");
     check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
           "reading the shared-memory limit");
+    limit -= dev::kStopCheckShared;  // the kernel's own, beside the tile
     TemporalTile t = o_.temporal_tile;
     if (t.x == 0) {  // the largest square or cube
       const int side = int(std::pow(double(std::size_t(limit) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
@@ -653,17 +684,18 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
     if (!volume) t.z = 1;
     if (t.z == 0) t.z = t.y;
+    const std::string need = "cuda-temporal: " + std::to_string(k_) + " steps a launch need a halo of " +
+                             std::to_string(halo) + " nodes around each tile; ";
+    if (t.x < 1)
+      throw std::invalid_argument(need + "no tile with it fits in the " + std::to_string(limit) +
+                                  " bytes of shared memory this device allows a block (choose fewer steps_per_launch)");
     const std::int64_t cells = std::int64_t(t.x + 2 * halo) * (t.y + 2 * halo) * (volume ? t.z + 2 * halo : 1);
     temporal_shared_ = std::size_t(cells) * cell;
-    if (t.x < 1 || temporal_shared_ > std::size_t(limit))
-      throw std::invalid_argument(
-          "cuda-temporal: " + std::to_string(k_) + " steps a launch need a halo of " +
-          std::to_string(halo) + " nodes around each tile; " +
-          (t.x < 1 ? std::string("no tile") : "a tile of " + std::to_string(t.x) + "x" + std::to_string(t.y) +
-                                                   (volume ? "x" + std::to_string(t.z) : "") + " nodes") +
-          " with it " + (t.x < 1 ? "fits in " : "needs " + std::to_string(temporal_shared_) + " bytes of ") +
-          "shared memory" + (t.x < 1 ? "" : ",") + " where this device allows " + std::to_string(limit) +
-          " a block (choose fewer steps_per_launch" + (t.x < 1 ? "" : " or a smaller tile") + ")");
+    if (temporal_shared_ > std::size_t(limit))
+      throw std::invalid_argument(need + "a tile of " + std::to_string(t.x) + "x" + std::to_string(t.y) +
+                                  (volume ? "x" + std::to_string(t.z) : "") + " nodes with it needs " +
+                                  std::to_string(temporal_shared_) + " bytes of shared memory, where this device allows " +
+                                  std::to_string(limit) + " a block (choose fewer steps_per_launch or a smaller tile)");
     temporal_tile_ = int3{t.x, t.y, t.z};
     if (temporal_blocks().y > 65535 || temporal_blocks().z > 65535)
       throw std::invalid_argument("cuda-temporal: the grid exceeds the CUDA launch limits with this tile");
@@ -711,19 +743,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       kernel<<<blocks, threads, temporal_shared_, stream_>>>(
           sp_, stencil_, float(sched_.weight()), pending_, temporal_tile_, x_[cur_].get(), v_[cur_].get(),
           verlet ? prev_[cur_].get() : nullptr, has_prev_, x_[nxt].get(), v_[nxt].get(),
-          verlet ? prev_[nxt].get() : nullptr, tg, stop_check(blocks, threads));
+          verlet ? prev_[nxt].get() : nullptr, tg, stop_check());
     });
     check_launch("launching the temporal step kernel");
   }
 
-  static std::int64_t warps_of(dim3 blocks, dim3 threads) {
-    return std::int64_t(blocks.x) * blocks.y * blocks.z * ((threads.x * threads.y * threads.z + 31) / 32);
-  }
-  // The stop rule's reduction in the launch that writes the step's result.
-  dev::StopCheck stop_check(dim3 blocks, dim3 threads) {
-    stop_warps_ = warps_of(blocks, threads);
-    return {warp_max_.get()};
-  }
+  // The stop rule's reduction in the launch that writes the step's result: a launch from
+  // state c adds into word c and clears the other, which a read-back queued after the launch
+  // before has taken (the step graphs hold one parity each).
+  dev::StopCheck stop_check() { return {stop_.get() + cur_, stop_.get() + (1 - cur_)}; }
 
   // A stage state or the step's result from the slopes with a non-zero weight.
   void combine_pass(const Pass& pass) {
@@ -741,7 +769,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     float4* vo = result ? v_[nxt].get() : sv_[pass.dst - 1].get();
     dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, xo, vo,
                                                          targets().end,
-                                                         result ? stop_check(blocks_for(n_), kBlock) : dev::StopCheck{});
+                                                         result ? stop_check() : dev::StopCheck{});
     check_launch("launching the combine kernel");
   }
 
@@ -756,13 +784,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
   Buffer<float4> prev_[2];  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
-  Buffer<unsigned> warp_max_, stop_max_;  // the stop rule's warp maxima (dev::StopCheck), their largest
-  Buffer<unsigned char> reduce_temp_;
-  std::int64_t stop_warps_ = 0;  // of the last step's launch
+  Buffer<unsigned> stop_;  // the largest displacement of a step from each state parity (stop_check)
   struct FreeHost {
-    void operator()(float4* p) const { cudaFreeHost(p); }
+    void operator()(void* p) const { cudaFreeHost(p); }
   };
   std::unique_ptr<float4, FreeHost> staging_;
+  static constexpr int kQueued = 2;  // displacement reads in flight
+  std::unique_ptr<unsigned, FreeHost> disp_host_;  // their words, pinned
+  cudaEvent_t disp_read_[kQueued] = {};
+  int head_ = 0, queued_ = 0;  // the oldest read in flight, how many
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
@@ -770,6 +800,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
+  enum class Back { none, possible, taken } back_ = Back::none;  // step_back
+  double back_t_ = 0.0;  // t_ before the last step
   std::int64_t launched_ = 0;  // steps queued on the device
 
   // cuda-temporal: steps are held back until a launch can take steps_per_launch of them (or

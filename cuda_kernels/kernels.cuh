@@ -127,14 +127,15 @@ __device__ __forceinline__ float advance_node(const StepParams& s, float weight,
   return P::displacement(xn, x, vn);
 }
 
-// The stop rule's reduction, begun by the kernel that writes a step's result: each warp
-// stores the largest term of its nodes (P::displacement: non-negative, infinite where the
-// state is not finite) as the bits of a float, which order as the floats do; the pipeline
-// reduces the warps' values when it is asked. Plain stores: no atomics on one hot address
-// and nothing to clear between steps.
+// The stop rule's reduction, in the launch that writes a step's result: the largest term
+// (P::displacement: non-negative, +inf where the state is not finite) as float bits, which
+// order as the floats do. Each block reduces its own and adds it with one atomicMax into `max`, which must be 0
+// at the launch; block 0 zeroes `clear`, the slot the next step's launch adds into.
 struct StopCheck {
-  unsigned* warp_max;  // one per warp of the launch; null: no check in this kernel
+  unsigned* max;    // null: no check in this kernel
+  unsigned* clear;
 };
+constexpr int kStopCheckShared = 32 * sizeof(unsigned);  // static shared memory of store_displacement
 
 __device__ __forceinline__ unsigned thread_in_block() {
   return (threadIdx.z * blockDim.y + threadIdx.y) * blockDim.x + threadIdx.x;
@@ -142,14 +143,19 @@ __device__ __forceinline__ unsigned thread_in_block() {
 
 // Called by every thread of the block, with its node's term (0 for a thread without a node).
 // The kernels keep such threads to the end rather than return early: the lanes of a warp are
-// then known without holding a mask through the kernel.
+// then known without holding a mask through the kernel, and all reach the barrier.
 __device__ __forceinline__ void store_displacement(const StopCheck& c, float d) {
+  __shared__ unsigned warp_max[kStopCheckShared / sizeof(unsigned)];
   const unsigned threads = blockDim.x * blockDim.y * blockDim.z, t = thread_in_block();
   const unsigned in_warp = min(32u, threads - (t - t % 32));
   const unsigned bits = __reduce_max_sync(in_warp == 32 ? 0xffffffffu : (1u << in_warp) - 1u, __float_as_uint(d));
-  if (t % 32 != 0) return;
-  const std::int64_t block = (std::int64_t(blockIdx.z) * gridDim.y + blockIdx.y) * gridDim.x + blockIdx.x;
-  c.warp_max[block * ((threads + 31) / 32) + t / 32] = bits;
+  if (t % 32 == 0) warp_max[t / 32] = bits;
+  __syncthreads();
+  if (t >= 32) return;
+  const unsigned block_max = __reduce_max_sync(0xffffffffu, t < (threads + 31) / 32 ? warp_max[t] : 0u);
+  if (t != 0) return;
+  atomicMax(c.max, block_max);
+  if (blockIdx.x == 0 && blockIdx.y == 0 && blockIdx.z == 0) *c.clear = 0u;
 }
 
 // ---- grid kernels: block (tile.x, tile.y) over (i, j), grid.z over layers k ----
@@ -379,7 +385,7 @@ struct Terms {
 // the stop rule's reduction: s0 + dt sum_j w_j k_j.
 __global__ void combine(StepParams s, const float4* __restrict__ x, const float4* __restrict__ v, Terms terms,
                         float4* __restrict__ xo, float4* __restrict__ vo, Vec3f end_target, StopCheck check) {
-  const bool result = check.warp_max != nullptr;
+  const bool result = check.max != nullptr;
   const std::int64_t t = thread_index();
   float d = 0.f;
   if (t < s.node_count) {

@@ -27,13 +27,6 @@ class ComputePipeline final : public GlPipeline {
       if (dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_)[1] > std::uint32_t(max_y))
         throw std::invalid_argument(name_ + ": " + std::to_string(w.count) + " nodes need more work groups than " +
                                     "this driver's " + std::to_string(max_x_) + " x " + std::to_string(max_y));
-    std::int64_t slots = 0;
-    for (const NodeWindow& w : windows_) {
-      const auto groups = dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_);
-      slots += std::int64_t(groups[0]) * groups[1];
-    }
-    group_max_ = make_buffer(std::size_t(slots) * 4);
-    group_slots_ = int(slots);
     init();
   }
 
@@ -47,7 +40,11 @@ class ComputePipeline final : public GlPipeline {
   void run_pass(GLuint program, const PassIO& io) override {
     const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
     glUseProgram(program);
-    int slot = 0;  // of the work-group maxima
+    if (io.result) {
+      const std::uint32_t zero = 0;
+      glClearNamedBufferSubData(io.result_max, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.result_max);
+    }
     for (const NodeWindow& w : windows_) {
       for (int k = 0; k < 5; ++k)
         if (in[k]->id()) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
@@ -57,11 +54,6 @@ class ComputePipeline final : public GlPipeline {
       glUniform1i(kCount, w.count);
       glUniform1i(kReadFirst, w.read_first);
       const auto groups = dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_);
-      if (io.result) {
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, group_max_.id());
-        glUniform1i(kGroupBase, slot);
-        slot += int(groups[0] * groups[1]);
-      }
       glDispatchCompute(groups[0], groups[1], 1);
     }
     // Later passes read this one's outputs as storage buffers and (earlier stages) as textures.
@@ -69,17 +61,11 @@ class ComputePipeline final : public GlPipeline {
     glUseProgram(0);
   }
 
-  // The result pass stored each work group's largest term (run_pass's barrier makes them
-  // visible): one dispatch reduces them.
-  void bind_terms(const std::function<void(int count, int stride, int word)>& reduce) override {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, group_max_.id());
-    reduce(group_slots_, 1, 0);
-  }
+  // The result pass reduced its terms into the word (run_pass's barrier makes it visible).
+  void reduce_displacement(GLuint) override {}
 
-  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2, kGroupBase = 3;  // uniform locations in step.comp
+  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2;  // uniform locations in step.comp
   GLint max_x_ = 0;  // work groups along x
-  Buffer group_max_;  // the stop rule's work-group maxima (step.comp)
-  int group_slots_ = 0;
 };
 
 }  // namespace

@@ -98,9 +98,19 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   if (adjacency) upload_adjacency();
   const std::uint32_t zero = 0;
   result_ = make_buffer(4, &zero);
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  readback_ = Buffer(id);
+  const GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+  glNamedBufferStorage(id, kQueued * 4, nullptr, flags);
+  readback_words_ = static_cast<const std::uint32_t*>(glMapNamedBufferRange(id, 0, kQueued * 4, flags));
+  if (!readback_words_) throw std::runtime_error(name_ + ": mapping the displacement read-back failed");
 }
 
-GlPipeline::~GlPipeline() = default;
+GlPipeline::~GlPipeline() {
+  for (GLsync& f : read_done_)
+    if (f) glDeleteSync(f);
+}
 
 void GlPipeline::require_texels(std::int64_t texels, const std::string& what) const {
   if (texels > max_texels_)
@@ -265,8 +275,6 @@ void GlPipeline::init() {
   }
   reduce_ = gl::make_program({{GL_COMPUTE_SHADER, "reduce.comp"}});
   reduce_n_ = uniform(reduce_.id(), "u_n");
-  reduce_stride_ = uniform(reduce_.id(), "u_stride");
-  reduce_word_ = uniform(reduce_.id(), "u_word");
   copy_ = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   copy_n_ = uniform(copy_.id(), "u_n");
   check(name_ + " setup");
@@ -309,6 +317,7 @@ void GlPipeline::set_state(const State& s) {
   glMemoryBarrier(GL_ALL_BARRIER_BITS);
   t_ = s.t;
   stepped_ = false;
+  back_ = Back::none;
   next_pass_ = 0;
   on_set_state();
   check(name_ + " set_state");
@@ -407,6 +416,7 @@ void GlPipeline::update(const Pass& pass) {
     io.out = {&x_[d], &v_[d], &xp_[d]};
     io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
     io.result = true;
+    io.result_max = result_.id();
   }
   if (shared_) io.forces_acc = &forces_acc_;
   run_pass(id, io);
@@ -418,6 +428,9 @@ void GlPipeline::finish_step() {
   check(name_ + " step");
   next_pass_ = 0;
   cur_ = 1 - cur_;
+  back_t_ = t_;
+  back_has_prev_ = has_prev_;
+  back_ = Back::possible;
   t_ += p_.dt;
   stepped_ = true;
   if (rule_ == UpdateRule::verlet) has_prev_ = true;
@@ -433,34 +446,67 @@ void GlPipeline::set_profiler(Profiler* p) {
   prof_ = p;
 }
 
-double GlPipeline::max_displacement() {
-  if (!stepped_) return 0.0;
+void GlPipeline::step_back() {
+  if (back_ != Back::possible) throw std::logic_error(name_ + ": no step to take back");
+  cur_ = 1 - cur_;
+  t_ = back_t_;
+  has_prev_ = back_has_prev_;
+  back_ = Back::taken;
+}
+
+void GlPipeline::queue_displacement() {
+  if (back_ == Back::taken) throw std::logic_error(name_ + ": the displacement before a step taken back is not kept");
+  if (queued_ == kQueued) throw std::logic_error(name_ + ": more displacement reads queued than taken");
   context();
-  const std::uint32_t zero = 0;
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, result_.id());
-  glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, 4, &zero);
-  glUseProgram(reduce_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
-  bind_terms([&](int count, int stride, int word) {
-    glUniform1i(reduce_n_, count);
-    glUniform1i(reduce_stride_, stride);
-    glUniform1i(reduce_word_, word);
-    glDispatchCompute(GLuint(std::min(1024, (count + 255) / 256)), 1, 1);
-  });
-  std::uint32_t bits = 0;
-  read_buffer(result_.id(), 0, 4, &bits);
-  glUseProgram(0);
-  check(name_ + " displacement reduction");
+  const int q = (head_ + queued_++) % kQueued;
+  if (stepped_) {
+    reduce_displacement(result_.id());
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glCopyNamedBufferSubData(result_.id(), readback_.id(), 0, GLintptr(q) * 4, 4);
+  } else {
+    const std::uint32_t zero = 0;
+    glClearNamedBufferSubData(readback_.id(), GL_R32UI, GLintptr(q) * 4, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  }
+  if (read_done_[q]) glDeleteSync(read_done_[q]);
+  read_done_[q] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  glFlush();  // the fence must reach the GPU before anyone waits for it
+  check(name_ + " displacement read-back");
+}
+
+double GlPipeline::take_displacement() {
+  if (queued_ == 0) throw std::logic_error(name_ + ": no displacement read queued");
+  context();
+  const int q = head_;
+  head_ = (head_ + 1) % kQueued;
+  --queued_;
+  GLenum r;
+  while ((r = glClientWaitSync(read_done_[q], GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000)) == GL_TIMEOUT_EXPIRED) {
+  }
+  if (r == GL_WAIT_FAILED) throw std::runtime_error(name_ + ": waiting for the displacement read-back failed");
+  check(name_ + " displacement read-back");
   float d;
-  std::memcpy(&d, &bits, 4);
+  std::memcpy(&d, readback_words_ + q, 4);
   return std::isfinite(d) ? double(d) : std::numeric_limits<double>::quiet_NaN();
 }
 
-void GlPipeline::bind_terms(const std::function<void(int count, int stride, int word)>& reduce) {
+double GlPipeline::max_displacement() {
+  queue_displacement();
+  double d = 0.0;
+  while (queued_ > 0) d = take_displacement();
+  return d;
+}
+
+void GlPipeline::reduce_displacement(GLuint result) {
+  const std::uint32_t zero = 0;
+  glClearNamedBufferSubData(result, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glUseProgram(reduce_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result);
   for (const NodeWindow& w : windows_) {
     bind_nodes(0, v_[cur_], w.first, w.count);
-    reduce(w.count, 4, 3);
+    glUniform1i(reduce_n_, w.count);
+    glDispatchCompute(GLuint(std::min(1024, (w.count + 255) / 256)), 1, 1);
   }
+  glUseProgram(0);
 }
 
 unsigned GlPipeline::gl_position_buffer() {

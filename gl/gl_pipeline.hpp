@@ -56,6 +56,11 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::array<GLuint, 2> slot_buffers(int slot) const;
   GLuint force_buffer() const { return forces_acc_.id(); }
   double max_displacement() override;
+  // The state sets ping-pong: the set before the last step is kept until the next one.
+  bool can_step_back() const override { return true; }
+  void step_back() override;
+  void queue_displacement() override;
+  double take_displacement() override;
   std::string timing_method() const override { return spans_.method(); }
   std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<QueryStepTimer>(); }
 
@@ -86,6 +91,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
     bool result;                   // it writes the step's result (and its stop-rule terms)
+    GLuint result_max;             // result passes: the word reduce_displacement() fills
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
@@ -106,10 +112,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
   virtual void on_set_state() {}
-  // Binds the last step's stop-rule terms (32-bit words, a float's bits) to storage binding 0,
-  // a range at a time, calling reduce(count, stride, word) after each: the terms are words
-  // word, word + stride, ... By default the w of the current velocities, window by window.
-  virtual void bind_terms(const std::function<void(int count, int stride, int word)>& reduce);
+  // Leaves the last step's largest displacement (a float's bits) in the word of buffer
+  // `result`, ready for a buffer copy. By default it reduces the w of the current velocities
+  // (the passes' stop-rule terms), window by window.
+  virtual void reduce_displacement(GLuint result);
 
   int n_ = 0;
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
@@ -151,19 +157,31 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass
   Buffer params_ubo_, adj_offset_, links_, result_;
+  // Queued displacement reads: each copies result_ into a word of readback_ (mapped at
+  // readback_words_), its fence signalled when the copy is done.
+  static constexpr int kQueued = 2;
+  Buffer readback_;
+  const std::uint32_t* readback_words_ = nullptr;
+  std::array<GLsync, kQueued> read_done_{};
+  int head_ = 0, queued_ = 0;
   Texture adj_offset_tex_;
   // The links in views of link_view_ texels each (units 9, then 11.. in shaders/sim.glsl).
   static constexpr int kLinkViews = 4;
   std::vector<Texture> link_views_;
   std::int64_t link_view_ = 0;
   Program reduce_, copy_;
-  GLint reduce_n_ = -1, reduce_stride_ = -1, reduce_word_ = -1, copy_n_ = -1;
+  GLint reduce_n_ = -1, copy_n_ = -1;
   std::int64_t max_texels_ = 0, max_block_nodes_ = 0;
   Profiler* prof_ = nullptr;
   TimerSpans spans_;  // the profiled steps
   int cur_ = 0;
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
+  // Whether the last step can be taken back, and what it changed besides cur_.
+  enum class Back { none, possible, taken };
+  Back back_ = Back::none;
+  double back_t_ = 0.0;
+  bool back_has_prev_ = false;
 };
 
 }  // namespace deformlab::gl

@@ -73,6 +73,10 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
     if (prof_ && force_spans_.pending() > 512) collect();
   }
   double max_displacement() override { return gl_->max_displacement(); }
+  bool can_step_back() const override { return gl_->can_step_back(); }
+  void step_back() override { gl_->step_back(); }
+  void queue_displacement() override { gl_->queue_displacement(); }
+  double take_displacement() override { return gl_->take_displacement(); }
   unsigned gl_position_buffer() override { return gl_->gl_position_buffer(); }
   std::string timing_method() const override {
     return "CUDA events (force), " + gl::Timer().method() + " (update), host clock (hand-off)";

@@ -34,7 +34,7 @@ match_tests="$build/tests/match/deformlab_match_tests"
 if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
   for tool in memcheck racecheck synccheck initcheck; do
     {
-      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*'
+      compute-sanitizer --tool "$tool" "$match_tests" --gtest_filter='*/cuda_*cloth37x53*:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*'
       compute-sanitizer --tool "$tool" "$cuda_tests" --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*:CudaTemporal*'
     } >"$out/sanitizer-$tool.log" 2>&1
     summary+=("$tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$tool.log" | tr '\n' ' ')")
@@ -90,8 +90,8 @@ if part experiments; then
 fi
 
 # One scene timed three ways (table2's scene at 2048^2, explicit Euler): `deformlab run`, its
-# experiment cell and deformlab-bench; then a run checking the stop rule every step against
-# one checking it once (the run's host wall time).
+# experiment cell and deformlab-bench; then runs checking the stop rule every step against
+# runs checking it once (the run's host wall time).
 median_of() { grep -o "\"$1\": [0-9.e+-]*" "$2" | head -1 | awk '{ print $2 }'; }
 if part timing; then
   cat >"$out/clock-check.json" <<'JSON'
@@ -112,11 +112,18 @@ JSON
     cell=$(ls "$out"/results/clock-check/cells/*"$p"* 2>/dev/null | head -1)
     summary+=("timing $p 2048^2 paper scene, ms/step: run $(median_of median_step_ms "$out/timing-run-$p.json"), cell $(median_of median_ms "$cell")")
   done
-  for p in cuda-fused glsl-compute; do
-    for every in 1 400; do
-      "$app" run --experiment table2 --pipeline "$p" --grid 2048x2048 --steps 400 --check-every "$every" --no-state \
-        --out "/tmp/check-$p-$every" >"$out/timing-check-$p-$every.log" 2>&1
-      summary+=("$p 2048^2, stop rule every $every steps: wall $(median_of wall_ms /tmp/check-$p-$every/manifest.json) ms for 400 steps, median step $(median_of median_step_ms /tmp/check-$p-$every/manifest.json) ms")
+  # Three runs each of 2000 steps; "/fast": math=fast.
+  for pm in cuda-fused cuda-fused/fast glsl-compute glsl-tf hybrid-compute; do
+    p=${pm%/*}; opt=(); [ "$pm" != "$p" ] && opt=(--option math=fast)
+    for every in 1 2000; do
+      walls=""
+      for rep in 1 2 3; do
+        "$app" run --experiment table2 --pipeline "$p" "${opt[@]}" --grid 2048x2048 --steps 2000 --check-every "$every" \
+          --no-state --out "/tmp/check-$rep" >"$out/timing-check-${pm/\//-}-$every-$rep.log" 2>&1
+        walls+=" $(median_of wall_ms /tmp/check-$rep/manifest.json)"
+        rm -rf "/tmp/check-$rep"
+      done
+      summary+=("$pm 2048^2, stop rule every $every steps: wall ms of 2000 steps:$walls")
     done
   done
 fi

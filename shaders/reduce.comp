@@ -1,19 +1,18 @@
 #version 430 core
-// The largest displacement of the last step: the max of its stop-rule terms (the bits of
-// non-negative floats, which order like the floats; +inf flags a non-finite node), word
-// u_word of every u_stride words (velocity.w: 4, 3; work-group maxima: 1, 0), reduced per
-// work group, then one atomicMax.
+// The largest displacement of the last step: the max of its stop-rule terms, the w of the
+// velocities (non-negative floats, whose bits order like the floats; +inf flags a non-finite
+// node), reduced per work group, then one atomicMax.
 layout(local_size_x = 256) in;
-layout(std430, binding = 0) readonly buffer Terms { uint terms[]; };
+layout(std430, binding = 0) readonly buffer Velocities { vec4 v[]; };
 layout(std430, binding = 1) buffer Result { uint max_bits; };
-uniform int u_n, u_stride, u_word;
+uniform int u_n;
 shared uint part[256];
 
 void main() {
   uint l = gl_LocalInvocationID.x;
   uint m = 0u;
   for (uint j = gl_GlobalInvocationID.x; j < uint(u_n); j += gl_NumWorkGroups.x * 256u)
-    m = max(m, terms[j * uint(u_stride) + uint(u_word)]);
+    m = max(m, floatBitsToUint(v[j].w));
   part[l] = m;
   barrier();
   for (uint s = 128u; s > 0u; s >>= 1) {

@@ -26,11 +26,10 @@ vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 #include "sim.glsl"
 
 #if PASS != PASS_STAGE
-// The stop rule's reduction in the pass that writes the step's result: each work group stores
+// The stop rule's reduction in the pass that writes the step's result: each work group takes
 // the largest term of its nodes (o1.w, non-negative, +inf where not finite) as float bits,
-// which order as the floats do; GlPipeline reduces the groups' values when asked.
-layout(std430, binding = 9) writeonly buffer GroupMax { uint group_max[]; };
-layout(location = 3) uniform int u_group_base;  // this dispatch's first slot in group_max
+// which order as the floats do, into the step's maximum (cleared before the pass).
+layout(std430, binding = 9) buffer StepMax { uint step_max; };
 shared uint group_term;
 #endif
 
@@ -61,7 +60,6 @@ void main() {
   }
 #if PASS != PASS_STAGE
   barrier();
-  if (gl_LocalInvocationIndex == 0u)
-    group_max[u_group_base + int(gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x)] = group_term;
+  if (gl_LocalInvocationIndex == 0u) atomicMax(step_max, group_term);
 #endif
 }

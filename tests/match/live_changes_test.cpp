@@ -12,6 +12,7 @@
 
 #include "core/cpu_backend.hpp"
 #include "experiments/pipelines.hpp"
+#include "tests/match/pipeline_names.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab::test {
@@ -115,11 +116,7 @@ std::vector<std::string> names() {
   return out;
 }
 
-INSTANTIATE_TEST_SUITE_P(All, LiveChanges, testing::ValuesIn(names()), [](const auto& info) {
-  std::string s = info.param;
-  std::replace(s.begin(), s.end(), '-', '_');
-  return s;
-});
+INSTANTIATE_TEST_SUITE_P(All, LiveChanges, testing::ValuesIn(names()), pipeline_test_name);
 
 }  // namespace
 }  // namespace deformlab::test

@@ -10,6 +10,7 @@
 
 #include "core/run.hpp"
 #include "experiments/pipelines.hpp"
+#include "tests/match/pipeline_names.hpp"
 #include "tests/support/test_states.hpp"
 
 namespace deformlab::test {
@@ -52,18 +53,7 @@ TEST_P(StepClock, TimesEveryStepWithinTheDrainedWallTime) {
   }
 }
 
-std::vector<std::string> names() {
-  std::vector<std::string> out;
-  for (const auto& e : pipelines().all()) out.push_back(e.name);
-  return out;
-}
-
-INSTANTIATE_TEST_SUITE_P(All, StepClock, testing::ValuesIn(names()), [](const auto& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (c == '-') c = '_';
-  return s;
-});
+INSTANTIATE_TEST_SUITE_P(All, StepClock, testing::ValuesIn(pipeline_names()), pipeline_test_name);
 
 }  // namespace
 }  // namespace deformlab::test

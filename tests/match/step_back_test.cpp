@@ -1,0 +1,164 @@
+// Lagged stop-rule checks (Pipeline::can_step_back): the run loop reads step n's displacement
+// while step n + 1 runs and takes n + 1 back when n met the rule. Every pipeline that can step
+// back must end a run where checks that wait for each step end it: the same step, state and
+// displacements (bit for bit where the pipeline is deterministic; within the scatter kernels'
+// atomic-order rounding otherwise), and catch divergence at the same step.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "core/run.hpp"
+#include "experiments/pipelines.hpp"
+#include "tests/match/pipeline_names.hpp"
+#include "tests/support/test_states.hpp"
+
+namespace deformlab::test {
+namespace {
+
+class StepBack : public testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    e_ = pipelines().find(GetParam());
+    if (const std::string why = e_->unavailable(); !why.empty()) GTEST_SKIP() << why;
+  }
+  const PipelineEntry* e_ = nullptr;
+};
+
+struct Ended {
+  RunResult r;
+  State s;
+  int diverged_at = 0;
+  bool could_step_back = false;
+};
+
+// From a perturbed state, until the stop rule holds; `wait`: an after_step callback makes every
+// check wait for its step.
+Ended run_from(const PipelineEntry& e, const Model& m, const Params& p, bool wait) {
+  auto pipe = e.make({m, p, Integrator::semi_implicit_euler});
+  pipe->set_state(perturbed_state(m, 7));
+  Ended out;
+  out.could_step_back = pipe->can_step_back();
+  RunOptions o{.until_converged = true};
+  if (wait) o.after_step = [](int) {};
+  try {
+    out.r = run(*pipe, m, p, o);
+  } catch (const DivergenceError& err) {
+    out.diverged_at = err.step;
+  }
+  out.s = pipe->state();
+  return out;
+}
+
+Params settling_params() {
+  Params p = small_params();
+  p.gravity = {};       // the perturbation settles back to rest in a few hundred steps
+  p.damping = 0.5f;
+  p.threshold = 1e-5f;  // 1 cm/s at dt = 1 ms
+  p.min_steps = 20;
+  p.max_steps = 4000;
+  return p;
+}
+
+TEST_P(StepBack, LaggedChecksEndWhereWaitingChecksEnd) {
+  const Model m = small_cloth(24, 24);
+  const Params p = settling_params();
+  const Ended lagged = run_from(*e_, m, p, false), waited = run_from(*e_, m, p, true);
+  if (!lagged.could_step_back) GTEST_SKIP() << GetParam() << " cannot step back: each check waits for its step";
+  ASSERT_TRUE(waited.r.converged) << "after " << waited.r.steps << " steps, last " << waited.r.last_displacement;
+  ASSERT_TRUE(lagged.r.converged) << "after " << lagged.r.steps << " steps";
+  EXPECT_EQ(lagged.s.t, lagged.r.steps * double(p.dt)) << "the step after the stop was not taken back";
+  ASSERT_EQ(int(lagged.r.records.size()), lagged.r.steps);
+  EXPECT_LT(lagged.r.last_displacement, p.threshold);
+  EXPECT_EQ(lagged.r.records.back().max_displacement, lagged.r.last_displacement);
+  EXPECT_GE(lagged.r.records[lagged.r.records.size() - 2].max_displacement, p.threshold);
+  if (e_->traits.deterministic) {
+    EXPECT_EQ(lagged.r.steps, waited.r.steps);
+    EXPECT_EQ(lagged.r.last_displacement, waited.r.last_displacement);
+    EXPECT_EQ(max_position_diff(lagged.s, waited.s), 0.0);
+    EXPECT_EQ(max_diff(lagged.s.v, waited.s.v), 0.0);
+  } else {  // near the rest state the atomic order moves the last step by a few
+    EXPECT_NEAR(lagged.r.steps, waited.r.steps, 0.05 * waited.r.steps);
+    EXPECT_LT(max_position_diff(lagged.s, waited.s), 1e-4);
+  }
+}
+
+TEST_P(StepBack, LaggedChecksCatchDivergenceAtTheSameStep) {
+  const Model m = small_cloth(24, 24);
+  Params p = settling_params();
+  p.damping = 0.02f;
+  p.dt = float(3 * stability_limit(m, p, Integrator::semi_implicit_euler));
+  const Ended lagged = run_from(*e_, m, p, false), waited = run_from(*e_, m, p, true);
+  if (!lagged.could_step_back) GTEST_SKIP() << GetParam() << " cannot step back: each check waits for its step";
+  ASSERT_GT(waited.diverged_at, 0);
+  // Growth at 3x the limit is a factor per step: rounding order moves it by a step at most.
+  EXPECT_NEAR(lagged.diverged_at, waited.diverged_at, e_->traits.deterministic ? 0 : 1);
+  EXPECT_EQ(lagged.s.t, lagged.diverged_at * double(p.dt)) << "the step after the divergence was not taken back";
+}
+
+// Bit for bit, or within a few ulp of the 1 m coordinates (the scatter kernels' atomic order).
+void expect_same(const State& a, const State& b, bool bitwise) {
+  if (bitwise) {
+    EXPECT_EQ(max_position_diff(a, b), 0.0);
+    EXPECT_EQ(max_diff(a.v, b.v), 0.0);
+  } else {
+    EXPECT_LT(max_position_diff(a, b), 1e-6);
+    EXPECT_LT(max_diff(a.v, b.v), 1e-4);
+  }
+}
+
+// The contract itself: one step back, to the state before the last step, then on as if the
+// step taken back had not been (its displacement word included).
+TEST_P(StepBack, TakesTheLastStepBackOnce) {
+  const Model m = small_cloth(24, 24);
+  const Params p = moving_params(m, Integrator::semi_implicit_euler);
+  auto pipe = e_->make({m, p, Integrator::semi_implicit_euler});
+  if (!pipe->can_step_back()) GTEST_SKIP() << GetParam() << " cannot step back";
+  auto twin = e_->make({m, p, Integrator::semi_implicit_euler});
+  pipe->set_state(perturbed_state(m, 3));
+  twin->set_state(perturbed_state(m, 3));
+  pipe->step();
+  twin->step();
+  const State one = twin->state();
+  pipe->step();
+  pipe->step_back();
+  const State back = pipe->state();
+  EXPECT_EQ(back.t, one.t);
+  expect_same(back, one, e_->traits.deterministic);
+  EXPECT_THROW(pipe->step_back(), std::logic_error);
+  EXPECT_THROW(pipe->queue_displacement(), std::logic_error);  // that step's read is gone
+  pipe->step();
+  twin->step();
+  const double d = pipe->max_displacement(), d_twin = twin->max_displacement();
+  if (e_->traits.deterministic)
+    EXPECT_EQ(d, d_twin);
+  else
+    EXPECT_NEAR(d, d_twin, 1e-6);
+  expect_same(pipe->state(), twin->state(), e_->traits.deterministic);
+}
+
+// Which pipelines take the lagged path: those whose kernels or passes ping-pong two state
+// sets. cuda-temporal advances k steps a launch and the CUDA Verlet kernels overwrite the
+// positions before the step, so their checks wait.
+TEST(StepBackPipelines, OneStepPipelinesCanStepBack) {
+  const std::set<std::string> can = {"cuda-fused", "cuda-tiled", "cuda-naive", "cuda-scatter",
+                                     "glsl-compute", "glsl-tf", "hybrid", "hybrid-compute"};
+  const Model m = small_cloth(8, 8);
+  const Params p = small_params();
+  int seen = 0;
+  for (const auto& e : pipelines().all()) {
+    if (!e.unavailable().empty() || e.traits.force == Engine::cpu) continue;
+    ++seen;
+    EXPECT_EQ(e.make({m, p, Integrator::semi_implicit_euler})->can_step_back(), can.count(e.name) == 1) << e.name;
+    if (e.unsupported(Integrator::verlet).empty()) {
+      const bool verlet_can = e.traits.update != Engine::cuda && can.count(e.name) == 1;
+      EXPECT_EQ(e.make({m, p, Integrator::verlet})->can_step_back(), verlet_can) << e.name << " (verlet)";
+    }
+  }
+  if (seen == 0) GTEST_SKIP() << "no GPU pipeline on this machine";
+}
+
+INSTANTIATE_TEST_SUITE_P(All, StepBack, testing::ValuesIn(pipeline_names()), pipeline_test_name);
+
+}  // namespace
+}  // namespace deformlab::test
