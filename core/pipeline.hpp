@@ -35,8 +35,8 @@ class Pipeline {
   // step can take that step back (once, until the next step); the run loop then checks step n
   // while step n + 1 runs and takes n + 1 back when n met the stop rule. queue_displacement()
   // queues the read of the last step's max_displacement() and returns at once;
-  // take_displacement() waits for the oldest one queued (two at most). Pipelines that cannot
-  // step back need not queue: the run waits at each check.
+  // take_displacement() waits for it (one read at a time, taken before the step after the next
+  // one). Pipelines that cannot step back need not queue: the run waits at each check.
   virtual bool can_step_back() const { return false; }
   virtual void step_back() { throw std::logic_error("this pipeline cannot take a step back"); }
   virtual void queue_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }

@@ -339,12 +339,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
     if (temporal_ && sched_.rule == UpdateRule::verlet)
       for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
-    stop_.allocate(2, "allocating the largest displacement");
+    stop_.allocate(3, "allocating the stop rule's reduction");
+    check(cudaMemsetAsync(stop_.get(), 0, 3 * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
     void* h = nullptr;
-    check(cudaMallocHost(&h, kQueued * sizeof(unsigned)), "allocating the displacement read-back");
-    disp_host_.reset(static_cast<unsigned*>(h));
-    for (cudaEvent_t& e : disp_read_)
-      check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "creating a read-back event");
+    check(cudaHostAlloc(&h, sizeof(unsigned long long), cudaHostAllocMapped), "allocating the displacement read-back");
+    disp_host_.reset(static_cast<unsigned long long*>(h));
+    *disp_host_ = 0;
+    check(cudaHostGetDevicePointer(reinterpret_cast<void**>(&disp_device_), h, 0), "mapping the displacement read-back");
 
     set_state(rest_state(m));
   }
@@ -352,8 +353,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   ~Impl() override {
     drop_graphs();
     if (copied_) cudaEventDestroy(copied_);
-    for (cudaEvent_t e : disp_read_)
-      if (e) cudaEventDestroy(e);
     if (stream_) cudaStreamDestroy(stream_);
   }
 
@@ -363,8 +362,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       throw std::invalid_argument("state size does not match the model");
     cur_ = 0;
     pending_ = 0;
-    queued_ = 0;
-    check(cudaMemsetAsync(stop_.get(), 0, 2 * sizeof(unsigned), stream_), "clearing the largest displacement");
+    queued_ = Read::none;
+    check(cudaMemsetAsync(stop_.get(), 0, 2 * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
     upload_positions(x_[0], s.x);
     upload_vectors(v_[0], s.v);
     has_prev_ = !s.x_prev.empty();
@@ -418,6 +417,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     t_ += p_.dt;
     stepped_ = true;
     ++launched_;
+    ++result_launches_;
   }
 
   // The one-step kernels read state cur_ and write the other; Verlet's overwrite the positions
@@ -428,39 +428,54 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     cur_ = 1 - cur_;
     t_ = back_t_;
     back_ = Back::taken;
-    // The step taken back added into the word the next step from this state adds into.
-    check(cudaMemsetAsync(stop_.get() + cur_, 0, sizeof(unsigned), stream_), "clearing the largest displacement");
+    // The launch taken back added into the word the next launch from this state adds into.
+    check(cudaMemsetAsync(stop_.get() + cur_, 0, sizeof(unsigned), stream_), "clearing the stop rule's reduction");
   }
 
-  // The last step's launch reduced its displacement into a word (dev::StopCheck): a read-back.
+  // The last step's launch left its largest displacement in a word (dev::StopCheck). The launch
+  // after it passes the word to the host; without one, the read copies it.
   void queue_displacement() override {
     flush();
     if (back_ == Back::taken) throw std::logic_error("the displacement before a step taken back is not kept");
-    if (queued_ == kQueued) throw std::logic_error("more displacement reads queued than taken");
-    const int q = (head_ + queued_++) % kQueued;
-    if (stepped_)
-      check(cudaMemcpyAsync(disp_host_.get() + q, stop_.get() + (1 - cur_), sizeof(unsigned), cudaMemcpyDeviceToHost,
-                            stream_),
-            "reading the largest displacement");
-    else
-      disp_host_.get()[q] = 0u;
-    check(cudaEventRecord(disp_read_[q], stream_), "marking the displacement read");
+    if (queued_ != Read::none) throw std::logic_error("a displacement read is queued and not taken");
+    queued_ = stepped_ ? Read::launch : Read::zero;
+    read_word_ = 1 - cur_;  // the launch read state 1 - cur_
+    read_after_ = result_launches_;
   }
   double take_displacement() override {
-    if (queued_ == 0) throw std::logic_error("no displacement read queued");
-    const int q = head_;
-    head_ = (head_ + 1) % kQueued;
-    --queued_;
-    check(cudaEventSynchronize(disp_read_[q]), "reducing the largest displacement");
+    if (queued_ == Read::none) throw std::logic_error("no displacement read queued");
+    if (std::exchange(queued_, Read::none) == Read::zero) return 0.0;
+    unsigned bits = 0;
+    if (result_launches_ > read_after_) {
+      bits = passed_on(read_after_ + 1);
+    } else {
+      unsigned* h = reinterpret_cast<unsigned*>(staging());
+      check(cudaMemcpyAsync(h, stop_.get() + read_word_, sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
+            "reading the largest displacement");
+      check(cudaStreamSynchronize(stream_), "reading the largest displacement");
+      bits = *h;
+    }
     float d = 0.f;
-    std::memcpy(&d, disp_host_.get() + q, sizeof d);
+    std::memcpy(&d, &bits, sizeof d);
     return std::isinf(d) ? std::numeric_limits<double>::quiet_NaN() : double(d);
   }
   double max_displacement() override {
     queue_displacement();
-    double d = 0.0;
-    while (queued_ > 0) d = take_displacement();
-    return d;
+    return take_displacement();
+  }
+  // Waits for result launch `launch` to pass the maximum of the one before to the host.
+  unsigned passed_on(unsigned long long launch) {
+    const unsigned want = unsigned(launch);  // the device counts in 32 bits
+    auto read = [&] { return *static_cast<volatile unsigned long long*>(disp_host_.get()); };
+    for (;;) {
+      const unsigned long long word = read();
+      if (unsigned(word >> 32) == want) return unsigned(word);
+      if (unsigned(word >> 32) > want) throw std::logic_error("a displacement read was taken two launches late");
+      const cudaError_t e = cudaStreamQuery(stream_);
+      if (e != cudaErrorNotReady) check(e, "reading the largest displacement");
+      if (e == cudaSuccess && unsigned(read() >> 32) != want)
+        throw std::runtime_error("the launch after a step did not pass its largest displacement on");
+    }
   }
 
   Energy energy() override {
@@ -726,6 +741,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
     launched_ += pending_;
+    ++result_launches_;
     pending_ = 0;
   }
   template <int Rule>
@@ -748,10 +764,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     check_launch("launching the temporal step kernel");
   }
 
-  // The stop rule's reduction in the launch that writes the step's result: a launch from
-  // state c adds into word c and clears the other, which a read-back queued after the launch
-  // before has taken (the step graphs hold one parity each).
-  dev::StopCheck stop_check() { return {stop_.get() + cur_, stop_.get() + (1 - cur_)}; }
+  // The stop rule's reduction in the launch that writes the step's result: a launch from state
+  // c adds into word c (the step graphs hold one parity each).
+  dev::StopCheck stop_check() { return {stop_.get() + cur_, stop_.get() + 1 - cur_, stop_.get() + 2, disp_device_}; }
 
   // A stage state or the step's result from the slopes with a non-zero weight.
   void combine_pass(const Pass& pass) {
@@ -784,15 +799,17 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
                                 // previous step's (Verlet: x_prev) until the next step
   Buffer<float4> sx_[3], sv_[3], acc_[4];
   Buffer<float4> prev_[2];  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
-  Buffer<unsigned> stop_;  // the largest displacement of a step from each state parity (stop_check)
+  Buffer<unsigned> stop_;  // the maximum of a launch from each state, the result launches (stop_check)
   struct FreeHost {
     void operator()(void* p) const { cudaFreeHost(p); }
   };
   std::unique_ptr<float4, FreeHost> staging_;
-  static constexpr int kQueued = 2;  // displacement reads in flight
-  std::unique_ptr<unsigned, FreeHost> disp_host_;  // their words, pinned
-  cudaEvent_t disp_read_[kQueued] = {};
-  int head_ = 0, queued_ = 0;  // the oldest read in flight, how many
+  std::unique_ptr<unsigned long long, FreeHost> disp_host_;  // dev::StopCheck::host
+  unsigned long long* disp_device_ = nullptr;                 // the same word for the device
+  unsigned long long result_launches_ = 0;                    // as the device counts them
+  enum class Read { none, launch, zero } queued_ = Read::none;  // zero: no step since set_state
+  int read_word_ = 0;                     // of the queued read
+  unsigned long long read_after_ = 0;     // result launches when it was queued
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy

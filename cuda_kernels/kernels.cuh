@@ -129,11 +129,14 @@ __device__ __forceinline__ float advance_node(const StepParams& s, float weight,
 
 // The stop rule's reduction, in the launch that writes a step's result: the largest term
 // (P::displacement: non-negative, +inf where the state is not finite) as float bits, which
-// order as the floats do. Each block reduces its own and adds it with one atomicMax into `max`, which must be 0
-// at the launch; block 0 zeroes `clear`, the slot the next step's launch adds into.
+// order as the floats do. Each block adds its own into `max` with one atomicMax. Block 0 also
+// passes the maximum of the launch before (complete, by stream order) to the host, tagged with
+// this launch's number, and clears its word, which the launch after this one adds into.
 struct StopCheck {
-  unsigned* max;    // null: no check in this kernel
-  unsigned* clear;
+  unsigned* max;       // 0 at the launch; null: no check in this kernel
+  unsigned* last;      // the launch before's
+  unsigned* launches;  // result launches so far
+  unsigned long long* host;  // mapped host memory: launch number << 32 | the launch before's maximum
 };
 constexpr int kStopCheckShared = 32 * sizeof(unsigned);  // static shared memory of store_displacement
 
@@ -155,7 +158,10 @@ __device__ __forceinline__ void store_displacement(const StopCheck& c, float d) 
   const unsigned block_max = __reduce_max_sync(0xffffffffu, t < (threads + 31) / 32 ? warp_max[t] : 0u);
   if (t != 0) return;
   atomicMax(c.max, block_max);
-  if (blockIdx.x == 0 && blockIdx.y == 0 && blockIdx.z == 0) *c.clear = 0u;
+  if (blockIdx.x != 0 || blockIdx.y != 0 || blockIdx.z != 0) return;
+  const unsigned long long launch = ++*c.launches;
+  *c.host = launch << 32 | atomicExch(c.last, 0u);
+  __threadfence_system();
 }
 
 // ---- grid kernels: block (tile.x, tile.y) over (i, j), grid.z over layers k ----

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "core/step_params.hpp"
 
@@ -102,14 +103,13 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   glCreateBuffers(1, &id);
   readback_ = Buffer(id);
   const GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
-  glNamedBufferStorage(id, kQueued * 4, nullptr, flags);
-  readback_words_ = static_cast<const std::uint32_t*>(glMapNamedBufferRange(id, 0, kQueued * 4, flags));
-  if (!readback_words_) throw std::runtime_error(name_ + ": mapping the displacement read-back failed");
+  glNamedBufferStorage(id, 4, nullptr, flags);
+  readback_word_ = static_cast<const std::uint32_t*>(glMapNamedBufferRange(id, 0, 4, flags));
+  if (!readback_word_) throw std::runtime_error(name_ + ": mapping the displacement read-back failed");
 }
 
 GlPipeline::~GlPipeline() {
-  for (GLsync& f : read_done_)
-    if (f) glDeleteSync(f);
+  if (read_done_) glDeleteSync(read_done_);
 }
 
 void GlPipeline::require_texels(std::int64_t texels, const std::string& what) const {
@@ -318,6 +318,7 @@ void GlPipeline::set_state(const State& s) {
   t_ = s.t;
   stepped_ = false;
   back_ = Back::none;
+  if (read_done_) glDeleteSync(std::exchange(read_done_, nullptr));  // a read of the state replaced
   next_pass_ = 0;
   on_set_state();
   check(name_ + " set_state");
@@ -456,44 +457,37 @@ void GlPipeline::step_back() {
 
 void GlPipeline::queue_displacement() {
   if (back_ == Back::taken) throw std::logic_error(name_ + ": the displacement before a step taken back is not kept");
-  if (queued_ == kQueued) throw std::logic_error(name_ + ": more displacement reads queued than taken");
+  if (read_done_) throw std::logic_error(name_ + ": a displacement read is queued and not taken");
   context();
-  const int q = (head_ + queued_++) % kQueued;
   if (stepped_) {
     reduce_displacement(result_.id());
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glCopyNamedBufferSubData(result_.id(), readback_.id(), 0, GLintptr(q) * 4, 4);
+    glCopyNamedBufferSubData(result_.id(), readback_.id(), 0, 0, 4);
   } else {
     const std::uint32_t zero = 0;
-    glClearNamedBufferSubData(readback_.id(), GL_R32UI, GLintptr(q) * 4, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glClearNamedBufferSubData(readback_.id(), GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   }
-  if (read_done_[q]) glDeleteSync(read_done_[q]);
-  read_done_[q] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-  glFlush();  // the fence must reach the GPU before anyone waits for it
+  read_done_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);  // take_displacement's wait flushes it
   check(name_ + " displacement read-back");
 }
 
 double GlPipeline::take_displacement() {
-  if (queued_ == 0) throw std::logic_error(name_ + ": no displacement read queued");
+  if (!read_done_) throw std::logic_error(name_ + ": no displacement read queued");
   context();
-  const int q = head_;
-  head_ = (head_ + 1) % kQueued;
-  --queued_;
   GLenum r;
-  while ((r = glClientWaitSync(read_done_[q], GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000)) == GL_TIMEOUT_EXPIRED) {
+  while ((r = glClientWaitSync(read_done_, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000)) == GL_TIMEOUT_EXPIRED) {
   }
+  glDeleteSync(std::exchange(read_done_, nullptr));
   if (r == GL_WAIT_FAILED) throw std::runtime_error(name_ + ": waiting for the displacement read-back failed");
   check(name_ + " displacement read-back");
   float d;
-  std::memcpy(&d, readback_words_ + q, 4);
+  std::memcpy(&d, readback_word_, 4);
   return std::isfinite(d) ? double(d) : std::numeric_limits<double>::quiet_NaN();
 }
 
 double GlPipeline::max_displacement() {
   queue_displacement();
-  double d = 0.0;
-  while (queued_ > 0) d = take_displacement();
-  return d;
+  return take_displacement();
 }
 
 void GlPipeline::reduce_displacement(GLuint result) {

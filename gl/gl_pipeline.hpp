@@ -157,13 +157,11 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass
   Buffer params_ubo_, adj_offset_, links_, result_;
-  // Queued displacement reads: each copies result_ into a word of readback_ (mapped at
-  // readback_words_), its fence signalled when the copy is done.
-  static constexpr int kQueued = 2;
+  // A queued displacement read copies result_ into readback_ (mapped at readback_word_); the
+  // fence is signalled when the copy is done.
   Buffer readback_;
-  const std::uint32_t* readback_words_ = nullptr;
-  std::array<GLsync, kQueued> read_done_{};
-  int head_ = 0, queued_ = 0;
+  const std::uint32_t* readback_word_ = nullptr;
+  GLsync read_done_ = nullptr;
   Texture adj_offset_tex_;
   // The links in views of link_view_ texels each (units 9, then 11.. in shaders/sim.glsl).
   static constexpr int kLinkViews = 4;
