@@ -58,7 +58,8 @@ struct RunResult {
 
 struct RunOptions {
   bool until_converged = false;  // else run exactly params.max_steps steps
-  // Called after every step (e.g. to write frames); may be empty.
+  // Called after every step (e.g. to write frames); may be empty. When set, each check waits
+  // for its step; else a pipeline that can step back has it read while the next step runs.
   std::function<void(int step)> after_step;
   // When set: the pipeline's own stage spans, "step" on the step clock and "reductions" on
   // the host clock.
