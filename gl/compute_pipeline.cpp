@@ -40,7 +40,7 @@ class ComputePipeline final : public GlPipeline {
   void run_pass(GLuint program, const PassIO& io) override {
     const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
     glUseProgram(program);
-    if (io.result_max) {
+    if (io.result) {
       const std::uint32_t zero = 0;
       glClearNamedBufferSubData(io.result_max, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.result_max);
@@ -62,7 +62,7 @@ class ComputePipeline final : public GlPipeline {
   }
 
   // The result pass reduced its terms into the word (run_pass's barrier makes it visible).
-  void reduce_displacement() override {}
+  void reduce_displacement(GLuint) override {}
 
   static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2;  // uniform locations in step.comp
   GLint max_x_ = 0;  // work groups along x

@@ -416,6 +416,7 @@ void GlPipeline::update(const Pass& pass) {
   } else {
     io.out = {&x_[d], &v_[d], &xp_[d]};
     io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
+    io.result = true;
     io.result_max = result_.id();
   }
   if (shared_) io.forces_acc = &forces_acc_;
@@ -459,7 +460,7 @@ void GlPipeline::queue_displacement() {
   if (read_done_) throw std::logic_error(name_ + ": a displacement read is queued and not taken");
   context();
   if (stepped_) {
-    reduce_displacement();
+    reduce_displacement(result_.id());
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glCopyNamedBufferSubData(result_.id(), readback_.id(), 0, 0, 4);
   } else {
@@ -489,11 +490,11 @@ double GlPipeline::max_displacement() {
   return take_displacement();
 }
 
-void GlPipeline::reduce_displacement() {
+void GlPipeline::reduce_displacement(GLuint result) {
   const std::uint32_t zero = 0;
-  glClearNamedBufferSubData(result_.id(), GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glClearNamedBufferSubData(result, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glUseProgram(reduce_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result);
   for (const NodeWindow& w : windows_) {
     bind_nodes(0, v_[cur_], w.first, w.count);
     glUniform1i(reduce_n_, w.count);

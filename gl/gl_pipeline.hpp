@@ -90,7 +90,8 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     std::array<const NodeBuffer*, 3> out;
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
-    GLuint result_max;  // it writes the step's result: the buffer of the word its stop-rule terms go to; else 0
+    bool result;                   // it writes the step's result (and its stop-rule terms)
+    GLuint result_max;             // result passes: the word reduce_displacement() fills
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
@@ -111,10 +112,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
   virtual void on_set_state() {}
-  // Leaves the last step's largest displacement (a float's bits) in PassIO::result_max's word,
-  // ready for a buffer copy. By default it reduces the w of the current velocities (the
-  // passes' stop-rule terms), window by window.
-  virtual void reduce_displacement();
+  // Leaves the last step's largest displacement (a float's bits) in the word of buffer
+  // `result`, ready for a buffer copy. By default it reduces the w of the current velocities
+  // (the passes' stop-rule terms), window by window.
+  virtual void reduce_displacement(GLuint result);
 
   int n_ = 0;
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
