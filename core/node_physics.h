@@ -74,14 +74,14 @@ DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj
 
 // Force on node i from a spring to node j (Hooke + damping along the spring axis):
 //   f_i = -(k (|d| - l) + kd (v_i - v_j).u) u,  d = x_i - x_j,  u = d / |d|.
-// (The paper's eq. (2) drops the minus sign.) Coincident nodes exert no force.
+// (The paper's eq. (2) drops the minus sign.) Coincident nodes exert no force: u is then 0.
+// Written without branches, so that GPUs evaluate it as one straight run of instructions
+// (and with fast math contract the result into the caller's sum).
 DL_FN vec3 spring_force(vec3 xi, vec3 xj, vec3 vi, vec3 vj, real k, real kd, real rest) {
   vec3 d = xi - xj;
   real len = DL_LENGTH(d);
-  if (len == real(0)) return ZERO3;
-  vec3 u = d * DL_RECIP(len);
-  real s = k * (len - rest);
-  if (kd != real(0)) s += kd * DL_DOT(vi - vj, u);  // skipped when undamped: same result, fewer instructions
+  vec3 u = d * (len > real(0) ? DL_RECIP(len) : real(0));
+  real s = k * (len - rest) + kd * DL_DOT(vi - vj, u);
   DL_PRECISE vec3 f = u * (-s);
   return f;
 }

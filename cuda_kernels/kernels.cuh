@@ -60,8 +60,8 @@ struct Window {
 template <int N, bool Damped, bool Checked>
 __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stencil& st, int i, int j, int k,
                                                 const Vec3f& xi, const Vec3f& vi, const Window& w) {
-  // Four at a time: the fused kernels then keep everything in 48 registers (6 or 8 spilled,
-  // costing 2-3% on the H100 at 2048^2).
+  // Two damped or four undamped neighbours at a time: more in flight spill registers under
+  // kGatherRegisters (four damped: 13% slower in fast math on the H100 at 2048^2).
   constexpr int G = Damped ? 2 : 4;
   Vec3f f{};
 #pragma unroll
@@ -168,8 +168,13 @@ __device__ __forceinline__ void store_displacement(const StopCheck& c, float d) 
 
 // Register cap of the grid gather kernels: the compiler's choice (about 80) limits an SM to
 // 3 blocks of 256 threads; the gather is issue-bound, and more resident warps hide its
-// latencies better (measured on the H100: 48 beats 64 and 80).
+// latencies better. Measured on the H100 (paper scene, 2048^2, fused): exact 48 (40: 11%
+// slower, 64 and 80 slower too); fast 40 (48 spills and is 11% slower, 36 8% slower).
+#ifdef DL_CUDA_FAST_MATH
+constexpr int kGatherRegisters = 40;
+#else
 constexpr int kGatherRegisters = 48;
+#endif
 
 // Halo of the shared tile: flexion springs reach two nodes.
 constexpr int kHalo = 2;
