@@ -20,19 +20,39 @@ class ComputePipeline final : public GlPipeline {
     const int need = shared ? 10 : 9;
     if (blocks < need)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
-    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_x_);
-    GLint max_y = 0;
-    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &max_y);
-    for (const NodeWindow& w : windows_)
-      if (dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_)[1] > std::uint32_t(max_y))
-        throw std::invalid_argument(name_ + ": " + std::to_string(w.count) + " nodes need more work groups than " +
-                                    "this driver's " + std::to_string(max_x_) + " x " + std::to_string(max_y));
+    for (GLuint d = 0; d < 3; ++d) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, d, &max_groups_[d]);
+    for (const NodeWindow& w : windows_) {
+      const auto g = work_groups(w).groups;
+      if (g[0] > std::uint32_t(max_groups_[0]) || g[1] > std::uint32_t(max_groups_[1]) ||
+          g[2] > std::uint32_t(max_groups_[2]))
+        throw std::invalid_argument(name_ + ": " + std::to_string(w.count) + " nodes need " + std::to_string(g[0]) +
+                                    " x " + std::to_string(g[1]) + " x " + std::to_string(g[2]) +
+                                    " work groups; this driver allows " + std::to_string(max_groups_[0]) + " x " +
+                                    std::to_string(max_groups_[1]) + " x " + std::to_string(max_groups_[2]));
+    }
     init();
   }
 
  private:
   Program make_program(int, const std::string& defines) override {
-    return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines);
+    const std::string tile = "#define TILE_X " + std::to_string(kTileX) + "\n#define TILE_Y " + std::to_string(kTileY) + "\n";
+    return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines + tile);
+  }
+
+  // A window's work groups (step.comp): on grids tiles of kTileX x kTileY nodes over the rows
+  // the window touches, tile rows along y then z; else 256 nodes a group along x then y.
+  struct WorkGroups {
+    std::array<std::uint32_t, 3> groups;
+    int first_row;
+  };
+  WorkGroups work_groups(const NodeWindow& w) const {
+    if (!model().grid()) {
+      const auto xy = dispatch_shape((std::int64_t(w.count) + 255) / 256, max_groups_[0]);
+      return {{xy[0], xy[1], 1}, 0};
+    }
+    const int first_row = w.first / model().nx, rows = (w.first + w.count - 1) / model().nx - first_row + 1;
+    const auto yz = dispatch_shape((rows + kTileY - 1) / kTileY, max_groups_[1]);
+    return {{std::uint32_t((model().nx + kTileX - 1) / kTileX), yz[0], yz[1]}, first_row};
   }
 
   // Window by window (node_windows): the inputs bound over the nodes the window reads, the
@@ -40,10 +60,9 @@ class ComputePipeline final : public GlPipeline {
   void run_pass(GLuint program, const PassIO& io) override {
     const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
     glUseProgram(program);
-    if (io.result) {
-      const std::uint32_t zero = 0;
-      glClearNamedBufferSubData(io.result_max, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    if (io.result_max) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.result_max);
+      glUniform1i(kResultWord, io.result_word);
     }
     for (const NodeWindow& w : windows_) {
       for (int k = 0; k < 5; ++k)
@@ -53,19 +72,26 @@ class ComputePipeline final : public GlPipeline {
       glUniform1i(kFirst, w.first);
       glUniform1i(kCount, w.count);
       glUniform1i(kReadFirst, w.read_first);
-      const auto groups = dispatch_shape((std::int64_t(w.count) + 255) / 256, max_x_);
-      glDispatchCompute(groups[0], groups[1], 1);
+      const WorkGroups g = work_groups(w);
+      glUniform1i(kFirstRow, g.first_row);
+      glDispatchCompute(g.groups[0], g.groups[1], g.groups[2]);
     }
-    // Later passes read this one's outputs as storage buffers and (earlier stages) as textures.
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    // Later passes read this one's outputs as storage buffers and (earlier stages) as textures,
+    // a displacement read copies the result pass's word.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    (io.result_max ? GL_BUFFER_UPDATE_BARRIER_BIT : 0));
     glUseProgram(0);
   }
 
   // The result pass reduced its terms into the word (run_pass's barrier makes it visible).
-  void reduce_displacement(GLuint) override {}
+  void reduce_displacement() override {}
 
-  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2;  // uniform locations in step.comp
-  GLint max_x_ = 0;  // work groups along x
+  // Uniform locations in step.comp.
+  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2, kFirstRow = 3, kResultWord = 4;
+  // A tile is a warp wide (coalesced rows) and 8 rows tall: 256 invocations reading 12 rows'
+  // worth of cache lines instead of 5 per row of 256.
+  static constexpr int kTileX = 32, kTileY = 8;
+  std::array<GLint, 3> max_groups_{};  // work groups along x, y, z
 };
 
 }  // namespace

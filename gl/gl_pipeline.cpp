@@ -97,8 +97,8 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   make_buffers();
   upload_params();
   if (adjacency) upload_adjacency();
-  const std::uint32_t zero = 0;
-  result_ = make_buffer(4, &zero);
+  const std::uint32_t zeros[2] = {0, 0};
+  result_ = make_buffer(sizeof zeros, zeros);
   GLuint id = 0;
   glCreateBuffers(1, &id);
   readback_ = Buffer(id);
@@ -259,7 +259,9 @@ void GlPipeline::plan() {
 void GlPipeline::init() {
   static const char* kind_define[] = {"PASS_ONE", "PASS_STAGE", "PASS_RESULT"};
   const std::string common = "#define RULE " + std::to_string(int(rule_)) + "\n" +
-                             (m_.grid() ? "#define TOPOLOGY_GRID 1\n" : "#define TOPOLOGY_GENERAL 1\n") +
+                             (m_.grid() ? "#define TOPOLOGY_GRID 1\n#define STENCIL_SIZE " +
+                                              std::to_string(grid_stencil_size(m_.volume())) + "\n"
+                                        : "#define TOPOLOGY_GENERAL 1\n") +
                              "#define LINK_VIEW " + std::to_string(std::max<std::int64_t>(link_view_, 1)) + "\n" +
                              (math_ == Math::exact ? "#define MATH_EXACT 1\n" : "#define MATH_FAST 1\n") +
                              (shared_ ? "#define EXTERNAL_FORCES 1\n" : "");
@@ -275,6 +277,7 @@ void GlPipeline::init() {
   }
   reduce_ = gl::make_program({{GL_COMPUTE_SHADER, "reduce.comp"}});
   reduce_n_ = uniform(reduce_.id(), "u_n");
+  reduce_word_ = uniform(reduce_.id(), "u_word");
   copy_ = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   copy_n_ = uniform(copy_.id(), "u_n");
   check(name_ + " setup");
@@ -314,6 +317,8 @@ void GlPipeline::set_state(const State& s) {
   upload(v_[cur_], s.v, false);
   has_prev_ = !s.x_prev.empty() && rule_ == UpdateRule::verlet;
   if (has_prev_) upload(xp_[cur_], s.x_prev, true);
+  const std::uint32_t zero = 0;
+  glClearNamedBufferData(result_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glMemoryBarrier(GL_ALL_BARRIER_BITS);
   t_ = s.t;
   stepped_ = false;
@@ -416,8 +421,8 @@ void GlPipeline::update(const Pass& pass) {
   } else {
     io.out = {&x_[d], &v_[d], &xp_[d]};
     io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
-    io.result = true;
     io.result_max = result_.id();
+    io.result_word = d;
   }
   if (shared_) io.forces_acc = &forces_acc_;
   run_pass(id, io);
@@ -449,6 +454,9 @@ void GlPipeline::set_profiler(Profiler* p) {
 
 void GlPipeline::step_back() {
   if (back_ != Back::possible) throw std::logic_error(name_ + ": no step to take back");
+  // The step taken back added its terms into the word the next step reduces into.
+  const std::uint32_t zero = 0;
+  glClearNamedBufferSubData(result_.id(), GL_R32UI, result_word(cur_), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   cur_ = 1 - cur_;
   t_ = back_t_;
   has_prev_ = back_has_prev_;
@@ -460,9 +468,8 @@ void GlPipeline::queue_displacement() {
   if (read_done_) throw std::logic_error(name_ + ": a displacement read is queued and not taken");
   context();
   if (stepped_) {
-    reduce_displacement(result_.id());
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glCopyNamedBufferSubData(result_.id(), readback_.id(), 0, 0, 4);
+    reduce_displacement();
+    glCopyNamedBufferSubData(result_.id(), readback_.id(), result_word(cur_), 0, 4);
   } else {
     const std::uint32_t zero = 0;
     glClearNamedBufferSubData(readback_.id(), GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -490,16 +497,18 @@ double GlPipeline::max_displacement() {
   return take_displacement();
 }
 
-void GlPipeline::reduce_displacement(GLuint result) {
+void GlPipeline::reduce_displacement() {
   const std::uint32_t zero = 0;
-  glClearNamedBufferSubData(result, GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glClearNamedBufferSubData(result_.id(), GL_R32UI, result_word(cur_), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glUseProgram(reduce_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
+  glUniform1i(reduce_word_, cur_);
   for (const NodeWindow& w : windows_) {
     bind_nodes(0, v_[cur_], w.first, w.count);
     glUniform1i(reduce_n_, w.count);
     glDispatchCompute(GLuint(std::min(1024, (w.count + 255) / 256)), 1, 1);
   }
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);  // for the copy
   glUseProgram(0);
 }
 

@@ -90,8 +90,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     std::array<const NodeBuffer*, 3> out;
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
-    bool result;                   // it writes the step's result (and its stop-rule terms)
-    GLuint result_max;             // result passes: the word reduce_displacement() fills
+    // Passes that write the step's result: the buffer of the stop-rule words (else 0) and the
+    // word of this step (set by its destination state set; the other is the step before's).
+    GLuint result_max;
+    int result_word;
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
@@ -112,10 +114,15 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   virtual void run_pass(GLuint program, const PassIO& io) = 0;
   // The state was replaced from the host.
   virtual void on_set_state() {}
-  // Leaves the last step's largest displacement (a float's bits) in the word of buffer
-  // `result`, ready for a buffer copy. By default it reduces the w of the current velocities
-  // (the passes' stop-rule terms), window by window.
-  virtual void reduce_displacement(GLuint result);
+  // Leaves the last step's largest displacement (a float's bits) in its stop-rule word
+  // (result_word(), visible to a buffer copy). By default it reduces the w of the current
+  // velocities (the passes' stop-rule terms), window by window.
+  virtual void reduce_displacement();
+  // The word of result_ that the step into state set `set` reduces into.
+  static GLintptr result_word(int set) { return GLintptr(set) * 4; }
+  Buffer result_;
+
+  const Model& model() const { return m_; }
 
   int n_ = 0;
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
@@ -156,8 +163,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::vector<GpuPass> passes_;
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass
-  Buffer params_ubo_, adj_offset_, links_, result_;
-  // A queued displacement read copies result_ into readback_ (mapped at readback_word_); the
+  Buffer params_ubo_, adj_offset_, links_;
+  // result_: a stop-rule word per state set, 0 before a step reduces into it. A queued
+  // displacement read copies the last step's word into readback_ (mapped at readback_word_); the
   // fence is signalled when the copy is done.
   Buffer readback_;
   const std::uint32_t* readback_word_ = nullptr;
@@ -168,7 +176,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::vector<Texture> link_views_;
   std::int64_t link_view_ = 0;
   Program reduce_, copy_;
-  GLint reduce_n_ = -1, copy_n_ = -1;
+  GLint reduce_n_ = -1, reduce_word_ = -1, copy_n_ = -1;
   std::int64_t max_texels_ = 0, max_block_nodes_ = 0;
   Profiler* prof_ = nullptr;
   TimerSpans spans_;  // the profiled steps

@@ -4,9 +4,9 @@
 // The including shader defines, before this file:
 //   vec4 src_x(int j), src_v(int j)  the state the forces are evaluated at (x.w: inverse mass)
 // and the host defines PASS (one of the PASS_* below), STAGE (the pass's stage, 0..3),
-// RULE (node_physics.h's RULE_*), TOPOLOGY_GRID or TOPOLOGY_GENERAL, and MATH_EXACT or
-// MATH_FAST (the pipeline option "math": the CPU float pipeline's operations, see
-// exact_math.glsl, or what the driver makes of the plain ones).
+// RULE (node_physics.h's RULE_*), TOPOLOGY_GRID (with STENCIL_SIZE, the stencil's entries)
+// or TOPOLOGY_GENERAL, and MATH_EXACT or MATH_FAST (the pipeline option "math": the CPU float
+// pipeline's operations, see exact_math.glsl, or what the driver makes of the plain ones).
 // With EXTERNAL_FORCES (the hybrid pipelines) another API's force pass wrote each node's
 // acceleration, which the including shader reads as vec4 forces_acc(int i).
 
@@ -73,8 +73,19 @@ vec4 link(int e) {
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
   DL_PRECISE vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
-  int ci = i % params.nx, cj = (i / params.nx) % params.ny, ck = i / (params.nx * params.ny);
-  for (int e = 0; e < params.stencil_count; ++e) {
+  // STENCIL_SIZE entries (a compile-time count, so that the loops unroll); only nodes within
+  // 2 of a border check whether each neighbour is in the grid.
+  int layer = params.nx * params.ny, ck = STENCIL_SIZE > 12 ? i / layer : 0, r = i - ck * layer;
+  int cj = r / params.nx, ci = r - cj * params.nx;
+  if (ci >= 2 && ci < params.nx - 2 && cj >= 2 && cj < params.ny - 2 &&
+      (STENCIL_SIZE == 12 || (ck >= 2 && ck < params.nz - 2))) {
+    for (int e = 0; e < STENCIL_SIZE; ++e) {
+      int j = i + stencil[e].di + stencil[e].dj * params.nx + stencil[e].dk * layer;
+      f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, stencil[e].k, stencil[e].kd, stencil[e].rest);
+    }
+    return f;
+  }
+  for (int e = 0; e < STENCIL_SIZE; ++e) {
     int j = grid_neighbour(params, ci, cj, ck, stencil[e].di, stencil[e].dj, stencil[e].dk);
     if (j >= 0) f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, stencil[e].k, stencil[e].kd, stencil[e].rest);
   }

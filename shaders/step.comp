@@ -2,10 +2,20 @@
 // The same step as step.vert, as a compute shader over shader storage buffers. A dispatch
 // covers one window of nodes (gl/gl_pipeline.hpp, node_windows): the inputs are bound from
 // node u_read_first, the outputs from node u_first.
+// On grids a work group is a tile of TILE_X x TILE_Y nodes (rows of nx nodes, a lattice's
+// layers stacked), so that the rows its springs reach come through the cache once for the
+// tile; the dispatch covers the window's rows from u_first_row, tile rows along y then z.
+// General models: 256 nodes a work group, along x then y.
+#ifdef TOPOLOGY_GRID
+layout(local_size_x = TILE_X, local_size_y = TILE_Y) in;
+#else
 layout(local_size_x = 256) in;
+#endif
 layout(location = 0) uniform int u_first;       // first node this dispatch writes
 layout(location = 1) uniform int u_count;       // nodes it writes
 layout(location = 2) uniform int u_read_first;  // first node of the bound inputs
+layout(location = 3) uniform int u_first_row;   // grids: the row of node u_first
+layout(location = 4) uniform int u_word;        // result passes: this step's stop-rule word
 
 layout(std430, binding = 0) readonly buffer S0X { vec4 s0_x[]; };  // current state
 layout(std430, binding = 1) readonly buffer S0V { vec4 s0_v[]; };
@@ -28,19 +38,27 @@ vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 #if PASS != PASS_STAGE
 // The stop rule's reduction in the pass that writes the step's result: each work group takes
 // the largest term of its nodes (o1.w, non-negative, +inf where not finite) as float bits,
-// which order as the floats do, into the step's maximum (cleared before the pass).
-layout(std430, binding = 9) buffer StepMax { uint step_max; };
+// which order as the floats do, into the step's word, which the step before cleared. Work
+// group 0 clears the other word, the step before's, for the step after (a read of it was
+// queued before this pass).
+layout(std430, binding = 9) buffer StepMax { uint step_max[2]; };
 shared uint group_term;
 #endif
 
 void main() {
+#ifdef TOPOLOGY_GRID
+  uint tile_row = gl_WorkGroupID.z * gl_NumWorkGroups.y + gl_WorkGroupID.y;
+  int row = u_first_row + int(tile_row * uint(TILE_Y) + gl_LocalInvocationID.y), col = int(gl_GlobalInvocationID.x);
+  int l = col < params.nx ? row * params.nx + col - u_first : -1;  // -1: outside the window
+#else
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
   int l = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);
+#endif
 #if PASS != PASS_STAGE
   if (gl_LocalInvocationIndex == 0u) group_term = 0u;
   barrier();  // every invocation reaches the barriers: none returns early
 #endif
-  if (l < u_count) {
+  if (l >= 0 && l < u_count) {
     int i = u_first + l, r = i - u_read_first;
 #if PASS == PASS_ONE && RULE == RULE_VERLET
     vec4 xp = s0_p[r];
@@ -60,6 +78,9 @@ void main() {
   }
 #if PASS != PASS_STAGE
   barrier();
-  if (gl_LocalInvocationIndex == 0u) atomicMax(step_max, group_term);
+  if (gl_LocalInvocationIndex == 0u) {
+    atomicMax(step_max[u_word], group_term);
+    if (gl_WorkGroupID == uvec3(0u)) step_max[1 - u_word] = 0u;
+  }
 #endif
 }
