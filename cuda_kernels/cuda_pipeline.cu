@@ -439,7 +439,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     if (back_ == Back::taken) throw std::logic_error("the displacement before a step taken back is not kept");
     if (queued_ != Read::none) throw std::logic_error("a displacement read is queued and not taken");
     queued_ = stepped_ ? Read::launch : Read::zero;
-    read_word_ = 1 - cur_;  // the launch read state 1 - cur_
     read_after_ = result_launches_;
   }
   double take_displacement() override {
@@ -450,7 +449,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       bits = passed_on(read_after_ + 1);
     } else {
       unsigned* h = reinterpret_cast<unsigned*>(staging());
-      check(cudaMemcpyAsync(h, stop_.get() + read_word_, sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
+      // No launch since: the last one read state 1 - cur_ and added into its word.
+      check(cudaMemcpyAsync(h, stop_.get() + 1 - cur_, sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
             "reading the largest displacement");
       check(cudaStreamSynchronize(stream_), "reading the largest displacement");
       bits = *h;
@@ -808,8 +808,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   unsigned long long* disp_device_ = nullptr;                 // the same word for the device
   unsigned long long result_launches_ = 0;                    // as the device counts them
   enum class Read { none, launch, zero } queued_ = Read::none;  // zero: no step since set_state
-  int read_word_ = 0;                     // of the queued read
-  unsigned long long read_after_ = 0;     // result launches when it was queued
+  unsigned long long read_after_ = 0;                         // result launches when the read was queued
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
