@@ -454,9 +454,7 @@ void GlPipeline::set_profiler(Profiler* p) {
 
 void GlPipeline::step_back() {
   if (back_ != Back::possible) throw std::logic_error(name_ + ": no step to take back");
-  // The step taken back added its terms into the word the next step reduces into.
-  const std::uint32_t zero = 0;
-  glClearNamedBufferSubData(result_.id(), GL_R32UI, result_word(cur_), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  clear_word(cur_);  // the step taken back added into the word the next step reduces into
   cur_ = 1 - cur_;
   t_ = back_t_;
   has_prev_ = back_has_prev_;
@@ -469,7 +467,7 @@ void GlPipeline::queue_displacement() {
   context();
   if (stepped_) {
     reduce_displacement();
-    glCopyNamedBufferSubData(result_.id(), readback_.id(), result_word(cur_), 0, 4);
+    glCopyNamedBufferSubData(result_.id(), readback_.id(), word_offset(cur_), 0, 4);
   } else {
     const std::uint32_t zero = 0;
     glClearNamedBufferSubData(readback_.id(), GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -497,9 +495,13 @@ double GlPipeline::max_displacement() {
   return take_displacement();
 }
 
-void GlPipeline::reduce_displacement() {
+void GlPipeline::clear_word(int set) {
   const std::uint32_t zero = 0;
-  glClearNamedBufferSubData(result_.id(), GL_R32UI, result_word(cur_), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glClearNamedBufferSubData(result_.id(), GL_R32UI, word_offset(set), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+}
+
+void GlPipeline::reduce_displacement() {
+  clear_word(cur_);
   glUseProgram(reduce_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, result_.id());
   glUniform1i(reduce_word_, cur_);

@@ -115,12 +115,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // The state was replaced from the host.
   virtual void on_set_state() {}
   // Leaves the last step's largest displacement (a float's bits) in its stop-rule word
-  // (result_word(), visible to a buffer copy). By default it reduces the w of the current
-  // velocities (the passes' stop-rule terms), window by window.
+  // (PassIO::result_word of its result pass), visible to a buffer copy. By default it reduces
+  // the w of the current velocities (the passes' stop-rule terms), window by window.
   virtual void reduce_displacement();
-  // The word of result_ that the step into state set `set` reduces into.
-  static GLintptr result_word(int set) { return GLintptr(set) * 4; }
-  Buffer result_;
 
   const Model& model() const { return m_; }
 
@@ -163,7 +160,11 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::vector<GpuPass> passes_;
   std::size_t next_pass_ = 0;  // of this step
   double force_t_ = 0.0;       // of the forces of the next pass
-  Buffer params_ubo_, adj_offset_, links_;
+  // Byte offset in result_ of the stop-rule word of the step into state set `set`; zeroing it.
+  static GLintptr word_offset(int set) { return GLintptr(set) * 4; }
+  void clear_word(int set);
+
+  Buffer params_ubo_, adj_offset_, links_, result_;
   // result_: a stop-rule word per state set, 0 before a step reduces into it. A queued
   // displacement read copies the last step's word into readback_ (mapped at readback_word_); the
   // fence is signalled when the copy is done.
