@@ -201,6 +201,10 @@ int run_command(const RunArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (const int k = pipe->steps_per_launch(); k > 1 && in.params.check_every % k != 0)
+      std::cerr << "deformlab: note: " << in.entry->name << " runs " << k << " steps a launch; checking the stop rule "
+                << "every " << in.params.check_every << " step(s) launches the steps held at each check, fewer at a "
+                << "time (--check-every " << k << " or a multiple of it keeps every launch whole)\n";
     Profiler profiler;
     profiler.stream_csv(dir.staged("spans.csv").string(), a.trace);  // the trace needs them all
     const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);

@@ -35,28 +35,33 @@ Experiment read_experiment(const RunArgs& a) {
   return x;
 }
 
-// The experiment's pipeline ("best": the best here for `integ`), available and running `integ`.
-const PipelineEntry* pick_pipeline(const Experiment& x, Integrator integ) {
+// The experiment's pipeline ("best": the best here for `integ`).
+const PipelineEntry* find_pipeline(const Experiment& x, Integrator integ) {
   const PipelineEntry* entry = x.pipeline == "best" ? &best_pipeline(integ) : pipelines().find(x.pipeline);
   if (!entry) throw BadInput("unknown pipeline '" + x.pipeline + "' (valid: best, " + pipelines().names() + ")");
+  return entry;
+}
+
+// Throws unless `entry` is available here and runs `integ`.
+void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator integ) {
   if (const auto why = entry->unavailable(); !why.empty())
     throw BadInput("pipeline '" + entry->name + "' is not available: " + why);
   if (const auto why = entry->unsupported(integ); !why.empty())
     throw BadInput("integrator '" + x.integrator + "' is not available on " + entry->name + ": " + why);
-  return entry;
 }
 
-// --option NAME=VALUE flags, each an option the pipeline reads.
+// --option NAME=VALUE flags, each an option the pipeline reads, with a value it can read.
 PipelineOptions parse_options(const std::vector<std::string>& flags, const PipelineEntry& entry) {
   PipelineOptions options;
   for (const auto& o : flags) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0) throw BadInput("--option '" + o + "': expected NAME=VALUE");
-    const std::string name = o.substr(0, eq);
-    if (std::find(entry.options.begin(), entry.options.end(), name) == entry.options.end())
-      throw BadInput("--option '" + name + "' is not an option of " + entry.name +
-                     (entry.options.empty() ? " (it has none)" : ""));
-    options[name] = o.substr(eq + 1);
+    options[o.substr(0, eq)] = o.substr(eq + 1);
+  }
+  try {
+    check_options(entry, options);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(e.what());
   }
   return options;
 }
@@ -115,8 +120,9 @@ RunInput read_run_input(const RunArgs& a) {
   const auto i = parse_integrator(in.x.integrator);
   if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");
   in.integ = *i;
-  in.entry = pick_pipeline(in.x, in.integ);
+  in.entry = find_pipeline(in.x, in.integ);
   in.options = parse_options(a.options, *in.entry);
+  require_runs(in.entry, in.x, in.integ);
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);

@@ -1,5 +1,6 @@
 #include "pipeline.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -25,6 +26,19 @@ Math math_option(const PipelineOptions& o) {
 
 CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o) {
   return math_option(o) == Math::fast ? CpuMatch::rounding : e.traits.cpu_match;
+}
+
+void check_options(const PipelineEntry& e, const PipelineOptions& o) {
+  for (const auto& [name, value] : o)
+    if (std::find(e.options.begin(), e.options.end(), name) == e.options.end())
+      throw std::invalid_argument("option '" + name + "' is not an option of " + e.name +
+                                  (e.options.empty() ? " (it has none)" : ""));
+  if (!e.read_options) return;
+  try {
+    e.read_options(o);
+  } catch (const std::invalid_argument& x) {
+    throw std::invalid_argument(e.name + ": " + x.what());
+  }
 }
 
 void PipelineRegistry::add(PipelineEntry e) {

@@ -41,6 +41,8 @@ class Pipeline {
   virtual void step_back() { throw std::logic_error("this pipeline cannot take a step back"); }
   virtual void queue_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
   virtual double take_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
+  // Steps it queues into one launch (cuda-temporal: k); a check launches the steps held so far.
+  virtual int steps_per_launch() const { return 1; }
   // A timer of this pipeline's steps on the clock of the device that runs them (valid while
   // the pipeline lives). The default: the host clock, for pipelines that step on the host.
   virtual std::unique_ptr<StepTimer> step_timer() { return std::make_unique<HostStepTimer>(); }
@@ -108,11 +110,18 @@ struct PipelineEntry {
   // Bytes it allocates for a model of this size beyond the model itself: on the host and on
   // its device (checked against the device's free memory when it is built).
   std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint = {};
+  // Reads the values of its options, throwing std::invalid_argument at the first it cannot
+  // (what depends on the device, such as a GL limit, is checked when the pipeline is made).
+  std::function<void(const PipelineOptions&)> read_options = {};
 };
 
 // How `e` run with options `o` compares with the `cpu` pipeline: its trait, or rounding
 // where the options choose fast math.
 CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o);
+
+// Throws std::invalid_argument, naming `e`, at the first option of `o` that `e` does not read
+// or whose value it cannot read: what a run or a sweep checks before anything runs.
+void check_options(const PipelineEntry& e, const PipelineOptions& o);
 
 // Empty when a run of `e` on a model of size `m` fits in this machine's host memory, else one
 // line naming the need (the model, the pipeline's own host buffers, a state read back; with a

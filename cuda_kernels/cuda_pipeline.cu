@@ -423,6 +423,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // The one-step kernels read state cur_ and write the other; Verlet's overwrite the positions
   // before it, cuda-temporal's advance k steps.
   bool can_step_back() const override { return !temporal_ && sched_.rule != UpdateRule::verlet; }
+  int steps_per_launch() const override { return temporal_ ? k_ : 1; }
   void step_back() override {
     if (!can_step_back() || back_ != Back::possible) throw std::logic_error("cuda pipeline: no step to take back");
     cur_ = 1 - cur_;
@@ -683,7 +684,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   void plan_temporal() {
     const Model& m = model_;
     temporal_ = true;
-    k_ = steps_per_launch(m, o_);
+    k_ = cuda::steps_per_launch(m, o_);
     const int halo = 2 * k_;
     const bool volume = m.volume();
     const std::size_t cell = 4 * sizeof(float4);
@@ -754,8 +755,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const dim3 blocks = temporal_blocks(), threads(dev::kTemporalThreads);
     with_grid_flags([&](auto n, auto damped) {
       const auto kernel = dev::temporal_grid<n(), damped(), Rule>;
-      check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(temporal_shared_)),
-            "raising the temporal kernel's shared-memory limit");
+      if (!temporal_limit_raised_)  // the pipeline launches this one kernel
+        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(temporal_shared_)),
+              "raising the temporal kernel's shared-memory limit");
+      temporal_limit_raised_ = true;
       kernel<<<blocks, threads, temporal_shared_, stream_>>>(
           sp_, stencil_, float(sched_.weight()), pending_, temporal_tile_, x_[cur_].get(), v_[cur_].get(),
           verlet ? prev_[cur_].get() : nullptr, has_prev_, x_[nxt].get(), v_[nxt].get(),
@@ -827,6 +830,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int3 temporal_tile_{};
   double held_t_[dev::kMaxStepsPerLaunch] = {};  // the held steps' start times
   std::size_t temporal_shared_ = 0;
+  bool temporal_limit_raised_ = false;
 };
 
 // The force pass alone, on the current device (the hybrid pipelines' CUDA stage).

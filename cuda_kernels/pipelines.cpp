@@ -187,7 +187,8 @@ void add_cuda_pipelines(PipelineRegistry& r) {
            options,
            [v](const ModelSize& m, Integrator i, const PipelineOptions& o) {
              return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, cuda::options_of(v, o))};
-           }});
+           },
+           [v](const PipelineOptions& o) { cuda::options_of(v, o); }});
   }
 }
 

@@ -125,6 +125,12 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
       });
       if (!read) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
     }
+  for (const Cell& c : cells(s))
+    try {
+      check_options(*pipelines().find(c.pipeline), c.options);
+    } catch (const std::invalid_argument& e) {
+      bad(w + ".options", e.what());
+    }
   return s;
 }
 

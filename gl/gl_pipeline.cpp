@@ -36,6 +36,17 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
+// A count option's value: a whole number of at least 1, else nothing.
+std::optional<std::int64_t> parse_count(const std::string& s) {
+  try {
+    std::size_t used = 0;
+    const std::int64_t v = std::stoll(s, &used);
+    if (used == s.size() && v >= 1) return v;
+  } catch (const std::logic_error&) {
+  }
+  return std::nullopt;
+}
+
 // The option "math", its error naming the pipeline.
 Math read_math(const std::string& name, const PipelineOptions& o) {
   try {
@@ -62,6 +73,13 @@ std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::in
     out.push_back({int(first), int(count), int(read_first), int(read_end - read_first)});
   }
   return out;
+}
+
+void read_options(const PipelineOptions& o) {
+  math_option(o);
+  for (const char* name : {"window", "link_view"})
+    if (const auto it = o.find(name); it != o.end() && !parse_count(it->second))
+      throw std::invalid_argument(std::string("option ") + name + " '" + it->second + "' is not a count of 1 or more");
 }
 
 Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
@@ -137,15 +155,11 @@ std::int64_t GlPipeline::count_option(const PipelineOptions& o, const std::strin
                                       const std::string& limit) const {
   const auto it = o.find(name);
   if (it == o.end()) return most;
-  try {
-    std::size_t used = 0;
-    const std::int64_t v = std::stoll(it->second, &used);
-    if (used != it->second.size() || v < 1 || v > most) throw std::out_of_range("");
-    return v;
-  } catch (const std::logic_error&) {
+  const auto v = parse_count(it->second);
+  if (!v || *v > most)
     throw std::invalid_argument(name_ + ": option " + name + " '" + it->second + "' is not a count from 1 to " +
                                 std::to_string(most) + " (" + limit + ")");
-  }
+  return *v;
 }
 
 void GlPipeline::plan_windows(const PipelineOptions& o) {

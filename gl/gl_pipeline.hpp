@@ -30,6 +30,10 @@ struct NodeWindow {
 // (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): larger models run window by window.
 std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align);
 
+// Reads the options' values as far as they do not depend on the GL context (PipelineEntry::
+// read_options): math, and window and link_view as counts.
+void read_options(const PipelineOptions& o);
+
 // Host and GPU bytes of a GL pipeline beyond the model (with an outside force stage: its
 // accelerations buffer too).
 Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces);

@@ -20,9 +20,10 @@ void add_gl_pipelines(PipelineRegistry& r) {
   // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows); "link_view":
   // links per texture-buffer view of a mesh's adjacency; "math": exact or fast.
   r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,
-         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window", "link_view", "math"}, footprint});
+         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window", "link_view", "math"}, footprint,
+         gl::read_options});
   r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", on(Engine::gl_transform_feedback),
-         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {"link_view", "math"}, footprint});
+         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {"link_view", "math"}, footprint, gl::read_options});
 }
 
 }  // namespace deformlab

@@ -58,7 +58,7 @@ const std::vector<BadInput>& cases() {
       {"threshold_zero", "run --pipeline cpu --threshold 0", "threshold"},
       {"check_every_zero", "run --pipeline cpu --check-every 0", "check_every"},
       {"compare_unknown", "run --compare gpu", "--compare"},
-      {"option_not_read", "run --pipeline cpu --option tile=8x8", "--option 'tile' is not an option of cpu"},
+      {"option_not_read", "run --pipeline cpu --option tile=8x8", "option 'tile' is not an option of cpu (it has none)"},
       {"option_no_value", "run --option tile", "expected NAME=VALUE"},
       {"unknown_flag", "run --colour red", "--colour"},
       {"grid_too_large", "run --grid 100000x100000", "exceeds the limit of 2^30 nodes"},

@@ -100,5 +100,19 @@ TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {
   EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
 }
 
+// cuda-temporal holds steps until a launch can take k of them; a check flushes what it holds,
+// so checks at other than multiples of k cut its launches short, which the run notes.
+TEST_F(Cli, TemporalRunNotesChecksThatCutItsLaunches) {
+  const std::string args = "run --pipeline cuda-temporal --integrator verlet --grid 24x24 --steps 8 --no-state --out ";
+  const Result every = run(args + (dir_ / "every").string());
+  if (every.err.find("is not available") != std::string::npos) GTEST_SKIP() << every.err;
+  EXPECT_EQ(every.code, 0) << every.err;
+  EXPECT_NE(every.err.find("note: cuda-temporal runs 4 steps a launch; checking the stop rule every 1 step(s)"),
+            std::string::npos) << every.err;
+  const Result whole = run(args + (dir_ / "whole").string() + " --check-every 4");
+  EXPECT_EQ(whole.code, 0) << whole.err;
+  EXPECT_EQ(whole.err.find("note:"), std::string::npos) << whole.err;
+}
+
 }  // namespace
 }  // namespace deformlab::test

@@ -28,6 +28,40 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_THROW(math_option({{"math", "quick"}}), std::invalid_argument);
 }
 
+// Option names and values are read before anything runs: a name the pipeline does not read,
+// and every value a backend built here cannot read, are refused with the pipeline's name.
+TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
+  const PipelineRegistry& r = pipelines();
+  const auto refusal = [&](const char* pipeline, const PipelineOptions& o) {
+    try {
+      check_options(*r.find(pipeline), o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refusal("cpu", {{"tile", "8x8"}}), "option 'tile' is not an option of cpu (it has none)");
+  EXPECT_EQ(refusal("glsl-tf", {{"window", "64"}}), "option 'window' is not an option of glsl-tf");
+  // Backends this build lacks stand in without reading values (their names are still checked).
+  int read = 0;
+  for (const auto& e : r.all()) {
+    if (!e.read_options) continue;
+    ++read;
+    EXPECT_EQ(refusal(e.name.c_str(), {{"math", "fast"}}), "") << e.name;
+    EXPECT_EQ(refusal(e.name.c_str(), {{"math", "rough"}}), e.name + ": option math 'rough' is not exact or fast");
+  }
+  if (read == 0) GTEST_SKIP() << "this build has no GPU backend, whose options have values to read";
+  const std::vector<std::pair<const char*, PipelineOptions>> bad = {
+      {"cuda-fused", {{"tile", "0x8"}}},           {"cuda-temporal", {{"steps_per_launch", "9"}}},
+      {"cuda-temporal", {{"tile", "40x"}}},        {"glsl-compute", {{"window", "0"}}},
+      {"glsl-tf", {{"link_view", "many"}}},        {"hybrid", {{"interop", "telepathy"}}},
+      {"hybrid-compute", {{"force", "fused"}}}};
+  for (const auto& [name, o] : bad)
+    if (r.find(name)->read_options) EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;
+  for (const char* name : {"cuda-temporal", "glsl-compute"})
+    if (r.find(name)->read_options) EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
+}
+
 // The check before a run adds the model, the pipeline's own host bytes and a state, and names
 // the limit that refuses it; grids cost the same whatever their spring count.
 TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {

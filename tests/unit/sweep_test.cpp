@@ -194,6 +194,11 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "omp"], "options": [{"tile": "8x8"}]})")
                 .find("sweep.options.tile: no pipeline of this sweep reads option 'tile'"),
             std::string::npos);
+  // A value is read before any cell runs (where this build has the backend that reads it).
+  if (pipelines().find("glsl-compute")->read_options)
+    EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "glsl-compute"], "options": [{"math": "rough"}]})")
+                  .find("sweep.options: glsl-compute: option math 'rough' is not exact or fast"),
+              std::string::npos);
 }
 
 TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
