@@ -62,7 +62,9 @@ class ComputePipeline final : public GlPipeline {
     glUseProgram(program);
     if (io.result_max) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.result_max);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, io.posted);
       glUniform1i(kResultWord, io.result_word);
+      glUniform1ui(kLaunch, io.launch);
     }
     for (const NodeWindow& w : windows_) {
       for (int k = 0; k < 5; ++k)
@@ -83,11 +85,13 @@ class ComputePipeline final : public GlPipeline {
     glUseProgram(0);
   }
 
-  // The result pass reduced its terms into the word (run_pass's barrier makes it visible).
+  // The result pass reduced its terms into the word (run_pass's barrier makes it visible), and
+  // the next one posts it.
   void reduce_displacement() override {}
+  bool posts_words() const override { return true; }
 
   // Uniform locations in step.comp.
-  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2, kFirstRow = 3, kResultWord = 4;
+  static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2, kFirstRow = 3, kResultWord = 4, kLaunch = 5;
   // A tile is a warp wide (coalesced rows) and 8 rows tall: 256 invocations reading 12 rows'
   // worth of cache lines instead of 5 per row of 256.
   static constexpr int kTileX = 32, kTileY = 8;

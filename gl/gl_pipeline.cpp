@@ -1,6 +1,9 @@
 #include "gl_pipeline.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <thread>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -121,8 +124,9 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   glCreateBuffers(1, &id);
   readback_ = Buffer(id);
   const GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
-  glNamedBufferStorage(id, 4, nullptr, flags);
-  readback_word_ = static_cast<const std::uint32_t*>(glMapNamedBufferRange(id, 0, 4, flags));
+  const std::uint64_t none = 0;
+  glNamedBufferStorage(id, 8, &none, flags);
+  readback_word_ = static_cast<std::uint64_t*>(glMapNamedBufferRange(id, 0, 8, flags));
   if (!readback_word_) throw std::runtime_error(name_ + ": mapping the displacement read-back failed");
 }
 
@@ -338,6 +342,7 @@ void GlPipeline::set_state(const State& s) {
   stepped_ = false;
   back_ = Back::none;
   if (read_done_) glDeleteSync(std::exchange(read_done_, nullptr));  // a read of the state replaced
+  read_queued_ = false;
   next_pass_ = 0;
   on_set_state();
   check(name_ + " set_state");
@@ -437,6 +442,8 @@ void GlPipeline::update(const Pass& pass) {
     io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
     io.result_max = result_.id();
     io.result_word = d;
+    io.posted = readback_.id();
+    io.launch = std::uint32_t(++launches_);
   }
   if (shared_) io.forces_acc = &forces_acc_;
   run_pass(id, io);
@@ -477,31 +484,66 @@ void GlPipeline::step_back() {
 
 void GlPipeline::queue_displacement() {
   if (back_ == Back::taken) throw std::logic_error(name_ + ": the displacement before a step taken back is not kept");
-  if (read_done_) throw std::logic_error(name_ + ": a displacement read is queued and not taken");
+  if (read_queued_) throw std::logic_error(name_ + ": a displacement read is queued and not taken");
   context();
-  if (stepped_) {
-    reduce_displacement();
-    glCopyNamedBufferSubData(result_.id(), readback_.id(), word_offset(cur_), 0, 4);
-  } else {
-    const std::uint32_t zero = 0;
-    glClearNamedBufferSubData(readback_.id(), GL_R32UI, 0, 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-  }
-  read_done_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);  // take_displacement's wait flushes it
+  read_queued_ = true;
+  read_launch_ = stepped_ ? launches_ : 0;
+  if (stepped_ && !posts_words()) copy_word();  // before the next step's passes reuse the word
   check(name_ + " displacement read-back");
 }
 
 double GlPipeline::take_displacement() {
-  if (!read_done_) throw std::logic_error(name_ + ": no displacement read queued");
+  if (!read_queued_) throw std::logic_error(name_ + ": no displacement read queued");
+  read_queued_ = false;
   context();
+  std::uint32_t bits = 0;
+  if (read_done_) {
+    bits = copied_word();
+  } else if (read_launch_ != 0 && launches_ != read_launch_) {
+    bits = posted_word(read_launch_);
+  } else if (read_launch_ != 0) {  // no step since: the word is still there
+    copy_word();
+    bits = copied_word();
+  }
+  check(name_ + " displacement read-back");
+  float d;
+  std::memcpy(&d, &bits, 4);
+  return std::isfinite(d) ? double(d) : std::numeric_limits<double>::quiet_NaN();
+}
+
+void GlPipeline::copy_word() {
+  reduce_displacement();
+  glCopyNamedBufferSubData(result_.id(), readback_.id(), word_offset(cur_), 4, 4);
+  read_done_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);  // copied_word's wait flushes it
+}
+
+std::uint32_t GlPipeline::copied_word() {
   GLenum r;
   while ((r = glClientWaitSync(read_done_, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000)) == GL_TIMEOUT_EXPIRED) {
   }
   glDeleteSync(std::exchange(read_done_, nullptr));
   if (r == GL_WAIT_FAILED) throw std::runtime_error(name_ + ": waiting for the displacement read-back failed");
-  check(name_ + " displacement read-back");
-  float d;
-  std::memcpy(&d, readback_word_, 4);
-  return std::isfinite(d) ? double(d) : std::numeric_limits<double>::quiet_NaN();
+  return std::uint32_t(std::atomic_ref(*readback_word_).load() >> 32);
+}
+
+// Coherent mapped memory shows a pass's write once it lands, but GL promises it only after a
+// fence or glFinish: the tag tells a posted word from an older one, and if none shows within a
+// second (a very long step, or a driver that holds writes back) glFinish settles it.
+std::uint32_t GlPipeline::posted_word(std::uint64_t launch) {
+  glFlush();  // the pass that posts it
+  const auto posted = [&]() -> std::optional<std::uint32_t> {
+    const std::uint64_t w = std::atomic_ref(*readback_word_).load(std::memory_order_acquire);
+    if (std::uint32_t(w) != std::uint32_t(launch)) return std::nullopt;
+    return std::uint32_t(w >> 32);
+  };
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(1)) {
+    if (const auto w = posted()) return *w;
+    std::this_thread::yield();  // a software renderer runs the pass on this machine's cores
+  }
+  glFinish();
+  if (const auto w = posted()) return *w;
+  throw std::runtime_error(name_ + ": the stop-rule word of result pass " + std::to_string(launch) + " was not posted");
 }
 
 double GlPipeline::max_displacement() {

@@ -98,6 +98,11 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     // word of this step (set by its destination state set; the other is the step before's).
     GLuint result_max;
     int result_word;
+    // Result passes of pipelines that post their words (posts_words): the host-mapped buffer
+    // the pass's first work group posts the step before's word into, tagged with launch - 1,
+    // the number of that step's result pass (low 32 bits).
+    GLuint posted;
+    std::uint32_t launch;
   };
 
   // With `shared`, the passes read accelerations that an outside force stage writes into
@@ -122,6 +127,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // (PassIO::result_word of its result pass), visible to a buffer copy. By default it reduces
   // the w of the current velocities (the passes' stop-rule terms), window by window.
   virtual void reduce_displacement();
+  // Whether each result pass posts the step before's word (PassIO::posted): a queued read then
+  // needs no copy and no fence when the next step follows it.
+  virtual bool posts_words() const { return false; }
 
   const Model& model() const { return m_; }
 
@@ -169,12 +177,19 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   void clear_word(int set);
 
   Buffer params_ubo_, adj_offset_, links_, result_;
-  // result_: a stop-rule word per state set, 0 before a step reduces into it. A queued
-  // displacement read copies the last step's word into readback_ (mapped at readback_word_); the
-  // fence is signalled when the copy is done.
+  // result_: a stop-rule word per state set, 0 before a step reduces into it. readback_,
+  // mapped at readback_word_: the posted word (low half: its tag, high half: the word); a copy
+  // of a word goes into its high half, and the fence read_done_ is signalled when it is done.
   Buffer readback_;
-  const std::uint32_t* readback_word_ = nullptr;
+  std::uint64_t* readback_word_ = nullptr;
   GLsync read_done_ = nullptr;
+  std::uint64_t launches_ = 0;  // result passes queued
+  // A queued read: of the word of result pass read_launch_ (0: no step since the state was set).
+  bool read_queued_ = false;
+  std::uint64_t read_launch_ = 0;
+  void copy_word();             // queues the copy of the last step's word and the fence
+  std::uint32_t copied_word();  // waits for the copy
+  std::uint32_t posted_word(std::uint64_t launch);  // waits for the word the next pass posts
   Texture adj_offset_tex_;
   // The links in views of link_view_ texels each (units 9, then 11.. in shaders/sim.glsl).
   static constexpr int kLinkViews = 4;

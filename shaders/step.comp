@@ -16,6 +16,7 @@ layout(location = 1) uniform int u_count;       // nodes it writes
 layout(location = 2) uniform int u_read_first;  // first node of the bound inputs
 layout(location = 3) uniform int u_first_row;   // grids: the row of node u_first
 layout(location = 4) uniform int u_word;        // result passes: this step's stop-rule word
+layout(location = 5) uniform uint u_launch;     // result passes: their number (low 32 bits)
 
 layout(std430, binding = 0) readonly buffer S0X { vec4 s0_x[]; };  // current state
 layout(std430, binding = 1) readonly buffer S0V { vec4 s0_v[]; };
@@ -39,9 +40,11 @@ vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 // The stop rule's reduction in the pass that writes the step's result: each work group takes
 // the largest term of its nodes (o1.w, non-negative, +inf where not finite) as float bits,
 // which order as the floats do, into the step's word, which the step before cleared. Work
-// group 0 clears the other word, the step before's, for the step after (a read of it was
-// queued before this pass).
+// group 0 of the first window posts the other word, the step before's (complete: its pass
+// ended at a barrier), to the host, tagged with that pass's number, and clears it for the step
+// after.
 layout(std430, binding = 9) buffer StepMax { uint step_max[2]; };
+layout(std430, binding = 10) writeonly buffer Posted { uvec2 posted; };  // mapped by the host
 shared uint group_term;
 #endif
 
@@ -80,7 +83,10 @@ void main() {
   barrier();
   if (gl_LocalInvocationIndex == 0u) {
     atomicMax(step_max[u_word], group_term);
-    if (gl_WorkGroupID == uvec3(0u)) step_max[1 - u_word] = 0u;
+    if (gl_WorkGroupID == uvec3(0u) && u_first == 0) {
+      posted = uvec2(u_launch - 1u, step_max[1 - u_word]);
+      step_max[1 - u_word] = 0u;
+    }
   }
 #endif
 }

@@ -73,6 +73,31 @@ TEST(ComputeDispatch, WindowedPassesGiveTheSameBits) {
   }
 }
 
+// A read queued after a step and taken after the next one (the word that step's result pass
+// posts to the host) equals the read that waits for the step (a copy of the word), step by
+// step, with one window and with several (only the first window's work group 0 posts).
+TEST(ComputeDispatch, PostedWordsEqualWaitedWords) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(37, 53);
+  const Params p = small_params();
+  const State s0 = perturbed_state(m, 5);
+  for (const PipelineOptions& o : {PipelineOptions{}, PipelineOptions{{"window", "400"}}})
+    for (Integrator i : {Integrator::semi_implicit_euler, Integrator::rk4}) {
+      auto waited = gl::make_compute_pipeline({m, p, i, o}), lagged = gl::make_compute_pipeline({m, p, i, o});
+      waited->set_state(s0);
+      lagged->set_state(s0);
+      lagged->step();
+      for (int k = 1; k <= 6; ++k) {
+        waited->step();
+        const double w = waited->max_displacement();
+        lagged->queue_displacement();
+        lagged->step();
+        EXPECT_EQ(lagged->take_displacement(), w) << info(i).name << ", step " << k << (o.empty() ? "" : ", windows");
+        EXPECT_GT(w, 0.0);
+      }
+    }
+}
+
 // A mesh's links beyond what the shaders' texture-buffer views hold are refused with the
 // counts (the split itself is checked against the CPU by tests/match, option link_view).
 TEST(LinkViews, TooManyViewsAndBadCountsAreRefused) {
