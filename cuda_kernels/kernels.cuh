@@ -169,7 +169,8 @@ __device__ __forceinline__ void store_displacement(const StopCheck& c, float d) 
 // Register cap of the grid gather kernels: the compiler's choice (about 80) limits an SM to
 // 3 blocks of 256 threads; the gather is issue-bound, and more resident warps hide its
 // latencies better. Measured on the H100 (paper scene, 2048^2, fused): exact 48 (40: 11%
-// slower, 64 and 80 slower too); fast 40 (48 spills and is 11% slower, 36 8% slower).
+// slower, 64 and 80 slower too); fast 40 (which spills 12-32 bytes a thread; 48 spills 28 and is
+// 11% slower, 36 8% slower).
 #ifdef DL_CUDA_FAST_MATH
 constexpr int kGatherRegisters = 40;
 #else
