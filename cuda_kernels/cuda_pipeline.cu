@@ -693,6 +693,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
           "reading the shared-memory limit");
     limit -= dev::kStopCheckShared;  // the kernel's own, beside the tile
+    temporal_shared_limit_ = limit;
     TemporalTile t = o_.temporal_tile;
     if (t.x == 0) {  // the largest square or cube
       const int side = int(std::pow(double(std::size_t(limit) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
@@ -755,8 +756,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const dim3 blocks = temporal_blocks(), threads(dev::kTemporalThreads);
     with_grid_flags([&](auto n, auto damped) {
       const auto kernel = dev::temporal_grid<n(), damped(), Rule>;
-      if (!temporal_limit_raised_)  // the pipeline launches this one kernel
-        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(temporal_shared_)),
+      // The limit is the kernel's, for every pipeline that launches it: raised to the device's
+      // (the same for all), once for the one kernel this pipeline launches.
+      if (!temporal_limit_raised_)
+        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, temporal_shared_limit_),
               "raising the temporal kernel's shared-memory limit");
       temporal_limit_raised_ = true;
       kernel<<<blocks, threads, temporal_shared_, stream_>>>(
@@ -830,6 +833,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int3 temporal_tile_{};
   double held_t_[dev::kMaxStepsPerLaunch] = {};  // the held steps' start times
   std::size_t temporal_shared_ = 0;
+  int temporal_shared_limit_ = 0;  // the device's, less the kernel's static shared memory
   bool temporal_limit_raised_ = false;
 };
 

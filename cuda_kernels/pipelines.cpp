@@ -25,7 +25,7 @@ Tile parse_tile(const std::string& s) {
     std::size_t a = 0, b = 0;
     if (x == std::string::npos) throw std::invalid_argument(s);
     const int w = std::stoi(s.substr(0, x), &a), h = std::stoi(s.substr(x + 1), &b);
-    if (a != x || b != s.size() - x - 1 || w < 1 || h < 1 || w * h > 1024) throw std::invalid_argument(s);
+    if (a != x || b != s.size() - x - 1 || w < 1 || h < 1 || std::int64_t(w) * h > 1024) throw std::invalid_argument(s);
     return {w, h};
   } catch (const std::logic_error&) {
     throw std::invalid_argument("CUDA tile '" + s + "' is not WxH with 1..1024 threads (e.g. 32x8)");

@@ -15,11 +15,15 @@ class ComputePipeline final : public GlPipeline {
  public:
   ComputePipeline(const PipelineSetup& s, const SharedAllocator& shared)
       : GlPipeline(s, shared ? "hybrid-compute" : "glsl-compute", shared) {
-    GLint blocks = 0;
+    // step.comp's blocks: bindings 0-7, the stop-rule words (9), the posted word (10) and, with an
+    // outside force stage, its accelerations (8).
+    GLint blocks = 0, bindings = 0;
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
-    const int need = shared ? 10 : 9;
-    if (blocks < need)
-      throw std::invalid_argument(name_ + " needs " + std::to_string(need) + " storage buffers per compute shader");
+    glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &bindings);
+    const int need = shared ? 11 : 10;
+    if (blocks < need || bindings < 11)
+      throw std::invalid_argument(name_ + " needs " + std::to_string(need) +
+                                  " storage buffers per compute shader and 11 storage buffer bindings");
     for (GLuint d = 0; d < 3; ++d) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, d, &max_groups_[d]);
     for (const NodeWindow& w : windows_) {
       const auto g = work_groups(w).groups;
@@ -79,7 +83,7 @@ class ComputePipeline final : public GlPipeline {
       glDispatchCompute(g.groups[0], g.groups[1], g.groups[2]);
     }
     // Later passes read this one's outputs as storage buffers and (earlier stages) as textures,
-    // a displacement read copies the result pass's word.
+    // a displacement read with no step after it copies the result pass's word.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     (io.result_max ? GL_BUFFER_UPDATE_BARRIER_BIT : 0));
     glUseProgram(0);

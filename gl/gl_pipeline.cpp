@@ -475,6 +475,9 @@ void GlPipeline::set_profiler(Profiler* p) {
 
 void GlPipeline::step_back() {
   if (back_ != Back::possible) throw std::logic_error(name_ + ": no step to take back");
+  // A read queued after the step taken back, and not posted (no step since): copied now, before
+  // the clears lose it.
+  if (read_queued_ && !read_done_ && read_launch_ != 0 && launches_ == read_launch_) copy_word();
   clear_word(cur_);  // the step taken back added into the word the next step reduces into
   cur_ = 1 - cur_;
   t_ = back_t_;
@@ -494,6 +497,8 @@ void GlPipeline::queue_displacement() {
 
 double GlPipeline::take_displacement() {
   if (!read_queued_) throw std::logic_error(name_ + ": no displacement read queued");
+  if (!read_done_ && read_launch_ != 0 && launches_ > read_launch_ + 1)
+    throw std::logic_error(name_ + ": a displacement read is taken after the step after the next one");
   read_queued_ = false;
   context();
   std::uint32_t bits = 0;

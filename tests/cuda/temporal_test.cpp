@@ -197,14 +197,15 @@ TEST(CudaTemporal, OptionsAreChecked) {
   for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4"})
     EXPECT_THROW(cuda::parse_temporal_tile(bad), std::invalid_argument) << bad;
   EXPECT_EQ(cuda::steps_per_launch(small_cloth(4, 4), {}), 4);
+  EXPECT_EQ(cuda::steps_per_launch(small_lattice(4, 4, 4), {}), 2);
+  EXPECT_FALSE(cuda::unsupported(Integrator::rk4, Variant::temporal).empty());
+  EXPECT_EQ(cuda::unsupported(Integrator::verlet, Variant::temporal), "");
+  // What a pipeline tells the run about its launches.
   if (const std::string why = cuda::unavailable(); !why.empty()) GTEST_SKIP() << why;
   const Model m = small_cloth(4, 4);
   const Params p = small_params();
   EXPECT_EQ(cuda::make_pipeline({m, p, Integrator::verlet}, temporal(3, {}, Math::exact))->steps_per_launch(), 3);
   EXPECT_EQ(cuda::make_pipeline({m, p, Integrator::verlet}, options(Variant::fused))->steps_per_launch(), 1);
-  EXPECT_EQ(cuda::steps_per_launch(small_lattice(4, 4, 4), {}), 2);
-  EXPECT_FALSE(cuda::unsupported(Integrator::rk4, Variant::temporal).empty());
-  EXPECT_EQ(cuda::unsupported(Integrator::verlet, Variant::temporal), "");
 }
 
 }  // namespace

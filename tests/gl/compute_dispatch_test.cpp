@@ -75,7 +75,8 @@ TEST(ComputeDispatch, WindowedPassesGiveTheSameBits) {
 
 // A read queued after a step and taken after the next one (the word that step's result pass
 // posts to the host) equals the read that waits for the step (a copy of the word), step by
-// step, with one window and with several (only the first window's work group 0 posts).
+// step, with one window and with several (only the first window's work group 0 posts); so
+// does a read queued before its step is taken back. A read taken two steps late is refused.
 TEST(ComputeDispatch, PostedWordsEqualWaitedWords) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_cloth(37, 53);
@@ -95,6 +96,15 @@ TEST(ComputeDispatch, PostedWordsEqualWaitedWords) {
         EXPECT_EQ(lagged->take_displacement(), w) << info(i).name << ", step " << k << (o.empty() ? "" : ", windows");
         EXPECT_GT(w, 0.0);
       }
+      waited->step();
+      lagged->queue_displacement();
+      lagged->step_back();
+      EXPECT_EQ(lagged->take_displacement(), waited->max_displacement()) << info(i).name << ", taken back";
+      lagged->step();
+      lagged->queue_displacement();
+      lagged->step();
+      lagged->step();
+      EXPECT_THROW(lagged->take_displacement(), std::logic_error);
     }
 }
 

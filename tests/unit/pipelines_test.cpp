@@ -52,7 +52,8 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
   }
   if (read == 0) GTEST_SKIP() << "this build has no GPU backend, whose options have values to read";
   const std::vector<std::pair<const char*, PipelineOptions>> bad = {
-      {"cuda-fused", {{"tile", "0x8"}}},           {"cuda-temporal", {{"steps_per_launch", "9"}}},
+      {"cuda-fused", {{"tile", "0x8"}}},           {"cuda-naive", {{"tile", "65536x65536"}}},  // 2^32 threads, not 0
+      {"cuda-temporal", {{"steps_per_launch", "9"}}},
       {"cuda-temporal", {{"tile", "40x"}}},        {"glsl-compute", {{"window", "0"}}},
       {"glsl-tf", {{"link_view", "many"}}},        {"hybrid", {{"interop", "telepathy"}}},
       {"hybrid-compute", {{"force", "fused"}}}};
