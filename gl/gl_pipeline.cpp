@@ -497,17 +497,16 @@ void GlPipeline::queue_displacement() {
 
 double GlPipeline::take_displacement() {
   if (!read_queued_) throw std::logic_error(name_ + ": no displacement read queued");
-  if (!read_done_ && read_launch_ != 0 && launches_ > read_launch_ + 1)
+  const std::uint64_t steps_since = launches_ - read_launch_;
+  if (!read_done_ && read_launch_ != 0 && steps_since > 1)
     throw std::logic_error(name_ + ": a displacement read is taken after the step after the next one");
   read_queued_ = false;
   context();
-  std::uint32_t bits = 0;
-  if (read_done_) {
-    bits = copied_word();
-  } else if (read_launch_ != 0 && launches_ != read_launch_) {
+  std::uint32_t bits = 0;  // no step before the read: nothing moved
+  if (!read_done_ && read_launch_ != 0 && steps_since == 1) {
     bits = posted_word(read_launch_);
-  } else if (read_launch_ != 0) {  // no step since: the word is still there
-    copy_word();
+  } else if (read_launch_ != 0) {  // copied when queued, or now: no step since
+    if (!read_done_) copy_word();
     bits = copied_word();
   }
   check(name_ + " displacement read-back");
