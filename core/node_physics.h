@@ -8,9 +8,10 @@
 //   VEC3(x, y, z)            a vector from its components
 //   DL_FINITE(a)             whether a scalar is finite (immune to fast math in GLSL)
 //   DL_INFINITY              +infinity
-//   DL_RECIP(a), DL_DOT(a, b), DL_LENGTH(a)
-//                            1 / a, a.b, |a|: the plain operations in C++ and CUDA; in GLSL's
-//                            exact math correctly rounded, and in C++'s order
+//   DL_RECIP(a), DL_RSQRT(a), DL_DOT(a, b), DL_LENGTH(a)
+//                            1 / a, 1 / sqrt(a), a.b, |a|: the plain operations in C++ and CUDA
+//                            (nvcc's fast math makes 1 / sqrt one instruction); in GLSL's exact
+//                            math correctly rounded, and in C++'s order
 //   DL_PRECISE               GLSL's precise in exact math, else nothing: on the locals a
 //                            function's result is computed in (OUT and INOUT carry it), as precise
 //                            covers what a function computes into its own precise variables
@@ -73,16 +74,20 @@ DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj
 }
 
 // Force on node i from a spring to node j (Hooke + damping along the spring axis):
-//   f_i = -(k (|d| - l) + kd (v_i - v_j).u) u,  d = x_i - x_j,  u = d / |d|.
-// (The paper's eq. (2) drops the minus sign.) Coincident nodes exert no force: u is then 0.
-// Written without branches, so that GPUs evaluate it as one straight run of instructions
-// (and with fast math contract the result into the caller's sum).
+//   f_i = -(k (|d| - l) + kd (v_i - v_j).u) u,  d = x_i - x_j,  u = d / |d|,
+// evaluated as  -(k (1 - l r) + kd ((v_i - v_j).d r) r) d  with r = 1 / |d|: one reciprocal square
+// root a spring (one instruction in fast math) and no division. (The paper's eq. (2) drops the
+// minus sign.) |d|^2 is taken as at least MIN_SQUARED_LENGTH, so that coincident nodes exert no
+// force and nodes closer than 1e-15 m a bounded one. Written without branches, so that GPUs
+// evaluate it as one straight run of instructions (and with fast math contract the result into
+// the caller's sum).
+#define MIN_SQUARED_LENGTH real(1e-30)  // m^2
 DL_FN vec3 spring_force(vec3 xi, vec3 xj, vec3 vi, vec3 vj, real k, real kd, real rest) {
   vec3 d = xi - xj;
-  real len = DL_LENGTH(d);
-  vec3 u = d * (len > real(0) ? DL_RECIP(len) : real(0));
-  real s = k * (len - rest) + kd * DL_DOT(vi - vj, u);
-  DL_PRECISE vec3 f = u * (-s);
+  real q = DL_DOT(d, d);
+  real r = DL_RSQRT(q > MIN_SQUARED_LENGTH ? q : MIN_SQUARED_LENGTH);
+  real c = k * (real(1) - rest * r) + kd * (DL_DOT(vi - vj, d) * r * r);
+  DL_PRECISE vec3 f = d * (-c);
   return f;
 }
 

@@ -1,6 +1,7 @@
 // The per-node physics of core/node_physics.h for C++ and CUDA: Physics<float> for the float
 // pipelines and kernels, Physics<double> for the reference and the energies.
 #pragma once
+#include <cmath>
 #include <limits>
 
 #include "vec3.hpp"
@@ -19,6 +20,7 @@ struct Physics {
 #define DL_FINITE(a) is_finite(a)
 #define DL_INFINITY std::numeric_limits<Real>::infinity()
 #define DL_RECIP(a) (real(1) / (a))
+#define DL_RSQRT(a) (real(1) / std::sqrt(a))
 #define DL_DOT(a, b) dot(a, b)
 #define DL_LENGTH(a) length(a)
 #define DL_PRECISE
@@ -31,6 +33,7 @@ struct Physics {
 #undef DL_FINITE
 #undef DL_INFINITY
 #undef DL_RECIP
+#undef DL_RSQRT
 #undef DL_DOT
 #undef DL_LENGTH
 #undef DL_PRECISE

@@ -3,6 +3,8 @@
 // to GLSL and to the GL pipelines' buffers, and runs one pass of the integrator's schedule.
 // The including shader defines, before this file:
 //   vec4 src_x(int j), src_v(int j)  the state the forces are evaluated at (x.w: inverse mass)
+// and, on grids, after it (it reads params):
+//   ivec3 node_cell(int i)           node i's grid coordinates (node_physics.h's grid_node inverted)
 // and the host defines PASS (one of the PASS_* below), STAGE (the pass's stage, 0..3),
 // RULE (node_physics.h's RULE_*), TOPOLOGY_GRID (with STENCIL_SIZE, the stencil's entries)
 // or TOPOLOGY_GENERAL, and MATH_EXACT or MATH_FAST (the pipeline option "math": the CPU float
@@ -22,11 +24,13 @@
 #include "exact_math.glsl"
 #define DL_PRECISE precise
 #define DL_RECIP(a) dl_recip(a)
+#define DL_RSQRT(a) dl_recip(dl_sqrt(a))
 #define DL_DOT(a, b) dl_dot(a, b)
 #define DL_LENGTH(a) dl_length(a)
 #elif defined(MATH_FAST)
 #define DL_PRECISE
 #define DL_RECIP(a) (real(1) / (a))
+#define DL_RSQRT(a) inversesqrt(a)
 #define DL_DOT(a, b) dot(a, b)
 #define DL_LENGTH(a) length(a)
 #else
@@ -70,23 +74,29 @@ vec4 link(int e) {
 }
 #endif
 
+#ifdef TOPOLOGY_GRID
+ivec3 node_cell(int i);
+#endif
+
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
   DL_PRECISE vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
   // STENCIL_SIZE entries (a compile-time count, so that the loops unroll); only nodes within
   // 2 of a border check whether each neighbour is in the grid.
-  int layer = params.nx * params.ny, ck = STENCIL_SIZE > 12 ? i / layer : 0, r = i - ck * layer;
-  int cj = r / params.nx, ci = r - cj * params.nx;
-  if (ci >= 2 && ci < params.nx - 2 && cj >= 2 && cj < params.ny - 2 &&
-      (STENCIL_SIZE == 12 || (ck >= 2 && ck < params.nz - 2))) {
+  ivec3 c = node_cell(i);
+  int layer = params.nx * params.ny;
+  if (c.x >= 2 && c.x < params.nx - 2 && c.y >= 2 && c.y < params.ny - 2 &&
+      (STENCIL_SIZE == 12 || (c.z >= 2 && c.z < params.nz - 2))) {
     for (int e = 0; e < STENCIL_SIZE; ++e) {
-      int j = i + stencil[e].di + stencil[e].dj * params.nx + stencil[e].dk * layer;
+      ivec3 o = ivec3(stencil[e].di, stencil[e].dj, stencil[e].dk);
+      int j = i + o.x + o.y * params.nx + o.z * layer;
       f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, stencil[e].k, stencil[e].kd, stencil[e].rest);
     }
     return f;
   }
   for (int e = 0; e < STENCIL_SIZE; ++e) {
-    int j = grid_neighbour(params, ci, cj, ck, stencil[e].di, stencil[e].dj, stencil[e].dk);
+    ivec3 o = ivec3(stencil[e].di, stencil[e].dj, stencil[e].dk);
+    int j = grid_neighbour(params, c.x, c.y, c.z, o.x, o.y, o.z);
     if (j >= 0) f += spring_force(xi, src_x(j).xyz, vi, src_v(j).xyz, stencil[e].k, stencil[e].kd, stencil[e].rest);
   }
 #else

@@ -36,6 +36,11 @@ vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 
 #include "sim.glsl"
 
+#ifdef TOPOLOGY_GRID
+ivec3 cell_;  // the invocation's node, set by main
+ivec3 node_cell(int i) { return cell_; }
+#endif
+
 #if PASS != PASS_STAGE
 // The stop rule's reduction in the pass that writes the step's result: each work group takes
 // the largest term of its nodes (o1.w, non-negative, +inf where not finite) as float bits,
@@ -53,6 +58,8 @@ void main() {
   uint tile_row = gl_WorkGroupID.z * gl_NumWorkGroups.y + gl_WorkGroupID.y;
   int row = u_first_row + int(tile_row * uint(TILE_Y) + gl_LocalInvocationID.y), col = int(gl_GlobalInvocationID.x);
   int l = col < params.nx ? row * params.nx + col - u_first : -1;  // -1: outside the window
+  int layer = STENCIL_SIZE > 12 ? row / params.ny : 0;
+  cell_ = ivec3(col, row - layer * params.ny, layer);
 #else
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
   int l = int(gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u);

@@ -17,6 +17,13 @@ vec4 forces_acc(int i) { return texelFetch(u_forces_acc, i); }
 
 #include "sim.glsl"
 
+#ifdef TOPOLOGY_GRID
+ivec3 node_cell(int i) {
+  int layer = params.nx * params.ny, k = STENCIL_SIZE > 12 ? i / layer : 0, r = i - k * layer, j = r / params.nx;
+  return ivec3(r - j * params.nx, j, k);
+}
+#endif
+
 out vec4 o0, o1, o2;
 
 void main() { node_pass(gl_VertexID, in_x, in_v, in_p, o0, o1, o2); }

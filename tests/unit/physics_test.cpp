@@ -7,6 +7,7 @@
 
 #include "core/cpu_backend.hpp"
 #include "core/energy.hpp"
+#include "core/physics.hpp"
 #include "core/run.hpp"
 #include "tests/support/test_states.hpp"
 
@@ -70,6 +71,37 @@ Oscillation oscillate(Integrator integ, double dt, double periods) {
   }
   o.period = ups > 1 ? (last_up - first_up) / (ups - 1) : 0;
   return o;
+}
+
+// The spring force as written for the GPUs (one reciprocal square root) against its textbook
+// form in double, -(k (|d| - l) + kd (v_i - v_j).u) u: within float rounding of the force's
+// size; equal and opposite from the other end; no force between coincident nodes, and a
+// bounded, finite one between nodes 1e-20 m apart.
+TEST(SpringForce, HookeAndDampingAlongTheAxis) {
+  using Pf = Physics<float>;
+  using Pd = Physics<double>;
+  const float k = 250.f, kd = 0.7f, rest = 0.05f;
+  const Vec3f xi{0.31f, -0.2f, 0.11f}, vi{0.4f, -1.2f, 0.3f}, vj{-0.5f, 0.2f, 0.9f};
+  for (const Vec3f xj : {Vec3f{0.33f, -0.17f, 0.12f}, Vec3f{0.36f, -0.2f, 0.11f}, Vec3f{0.2f, 0.1f, -0.4f}}) {
+    const Vec3d d{double(xi.x) - xj.x, double(xi.y) - xj.y, double(xi.z) - xj.z};
+    const double len = length(d);
+    const Vec3d u{d.x / len, d.y / len, d.z / len};
+    const double s = k * (len - rest) + kd * ((double(vi.x) - vj.x) * u.x + (double(vi.y) - vj.y) * u.y +
+                                              (double(vi.z) - vj.z) * u.z);
+    const Vec3f f = Pf::spring_force(xi, xj, vi, vj, k, kd, rest), g = Pf::spring_force(xj, xi, vj, vi, k, kd, rest);
+    const double tol = 4e-7 * (std::abs(s) + k * rest);
+    EXPECT_NEAR(f.x, -s * u.x, tol);
+    EXPECT_NEAR(f.y, -s * u.y, tol);
+    EXPECT_NEAR(f.z, -s * u.z, tol);
+    EXPECT_TRUE(g.x == -f.x && g.y == -f.y && g.z == -f.z);
+    const Vec3d fd = Pd::spring_force(Vec3d{xi.x, xi.y, xi.z}, Vec3d{xj.x, xj.y, xj.z}, Vec3d{vi.x, vi.y, vi.z},
+                                      Vec3d{vj.x, vj.y, vj.z}, k, kd, rest);
+    EXPECT_NEAR(fd.x, -s * u.x, 1e-12 * k);
+  }
+  const Vec3f same = Pf::spring_force(xi, xi, vi, vj, k, kd, rest);
+  EXPECT_TRUE(same.x == 0.f && same.y == 0.f && same.z == 0.f);
+  const Vec3f near = Pf::spring_force(Vec3f{1e-20f, 0.f, 0.f}, Vec3f{}, vi, vj, k, kd, rest);
+  EXPECT_TRUE(std::isfinite(near.x) && std::abs(near.x) <= k * rest);
 }
 
 TEST(Oscillator, Rk4MatchesTheAnalyticSolution) {
