@@ -39,6 +39,18 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
+// The grid stencil for the shaders: its size and its offsets (core/grid_stencil.hpp's table).
+std::string stencil_defines(bool volume) {
+  const int n = grid_stencil_size(volume);
+  std::string offsets;
+  for (int e = 0; e < n; ++e) {
+    const GridOffset o = grid_offset(volume, e);
+    offsets += std::string(e ? ", " : "") + "ivec3(" + std::to_string(o.di) + ", " + std::to_string(o.dj) + ", " +
+               std::to_string(o.dk) + ")";
+  }
+  return "#define STENCIL_SIZE " + std::to_string(n) + "\n#define STENCIL_OFFSETS ivec3[](" + offsets + ")\n";
+}
+
 // A count option's value: a whole number of at least 1, else nothing.
 std::optional<std::int64_t> parse_count(const std::string& s) {
   try {
@@ -277,8 +289,7 @@ void GlPipeline::plan() {
 void GlPipeline::init() {
   static const char* kind_define[] = {"PASS_ONE", "PASS_STAGE", "PASS_RESULT"};
   const std::string common = "#define RULE " + std::to_string(int(rule_)) + "\n" +
-                             (m_.grid() ? "#define TOPOLOGY_GRID 1\n#define STENCIL_SIZE " +
-                                              std::to_string(grid_stencil_size(m_.volume())) + "\n"
+                             (m_.grid() ? "#define TOPOLOGY_GRID 1\n" + stencil_defines(m_.volume())
                                         : "#define TOPOLOGY_GENERAL 1\n") +
                              "#define LINK_VIEW " + std::to_string(std::max<std::int64_t>(link_view_, 1)) + "\n" +
                              (math_ == Math::exact ? "#define MATH_EXACT 1\n" : "#define MATH_FAST 1\n") +
