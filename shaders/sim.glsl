@@ -93,7 +93,7 @@ const ivec3 kStencilOffset[STENCIL_SIZE] = STENCIL_OFFSETS;
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
   DL_PRECISE vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
-  // STENCIL_SIZE entries (a compile-time count, so that the loops unroll); only nodes within
+  // STENCIL_SIZE entries (a compile-time count, so that the loops can unroll); only nodes within
   // 2 of a border check whether each neighbour is in the grid.
   ivec3 c = node_cell(i);
   int layer = params.nx * params.ny;
