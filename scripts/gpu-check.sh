@@ -7,13 +7,14 @@
 # to run, default all but timing, scale, endurance and speed),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
+# LABELS (the tests part's ctest -L regex, default every label),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
 # timing part's experiment cells again).
-# The build folder can travel as .dev/build.tgz (scripts/pack-for-device.sh), unpacked here.
+# The build folder can travel as .dev/build.tar.xz (scripts/pack-for-device.sh), unpacked here.
 set -uo pipefail
 cd "$(dirname "$0")/.."
-for t in .dev/*.tgz; do [ -f "$t" ] && tar -xzf "$t"; done
+for t in .dev/*.tar.xz; do [ -f "$t" ] && xz -dc "$t" | tar -xf -; done
 build=${BUILD:-build/default}
 out=${1:-gpu-check}
 max=${MAX_SIZE:-4096}
@@ -24,7 +25,7 @@ app="$build/app/deformlab"
 part() { [[ " $parts " == *" $1 "* ]]; }
 
 if part tests; then
-  ctest --test-dir "$build" -j"${JOBS:-4}" --output-on-failure >"$out/ctest.log" 2>&1
+  ctest --test-dir "$build" -j"${JOBS:-4}" ${LABELS:+-L "$LABELS"} --output-on-failure >"$out/ctest.log" 2>&1
   summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
   grep -E "Label|^ *(unit|match|gl|cuda|interop|viewer) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"
 fi
