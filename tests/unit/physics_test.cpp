@@ -97,6 +97,8 @@ TEST(SpringForce, HookeAndDampingAlongTheAxis) {
     const Vec3d fd = Pd::spring_force(Vec3d{xi.x, xi.y, xi.z}, Vec3d{xj.x, xj.y, xj.z}, Vec3d{vi.x, vi.y, vi.z},
                                       Vec3d{vj.x, vj.y, vj.z}, k, kd, rest);
     EXPECT_NEAR(fd.x, -s * u.x, 1e-12 * k);
+    EXPECT_NEAR(fd.y, -s * u.y, 1e-12 * k);
+    EXPECT_NEAR(fd.z, -s * u.z, 1e-12 * k);
   }
   const Vec3f same = Pf::spring_force(xi, xi, vi, vj, k, kd, rest);
   EXPECT_TRUE(same.x == 0.f && same.y == 0.f && same.z == 0.f);
