@@ -27,6 +27,7 @@ struct CudaOptions : BenchOptions {
   double reference_ms = 0.48;
   std::vector<int> temporal_sizes{2048, 8192};
   std::vector<int> steps_per_launch{1, 2, 4, 8};
+  std::vector<std::string> temporal_tiles{"default"};
 };
 
 cuda::Variant parse_variant(const std::string& s) {
@@ -78,7 +79,7 @@ class Report {
     r.integrator = std::string(info(integ).name);
     r.tile = std::to_string(opt.tile.x) + "x" + std::to_string(opt.tile.y);
     r.math = to_string(opt.math);
-    const int k = opt.variant == cuda::Variant::temporal ? cuda::steps_per_launch(m, opt) : 1;
+    const int k = opt.variant == cuda::Variant::temporal ? cuda::steps_per_launch(opt) : 1;
     r.graphs = opt.graphs;
     r.nodes = m.node_count();
     r.ms = st.median;
@@ -184,26 +185,30 @@ void run_cuda(const CudaOptions& o) {
   }
 
   if (!o.temporal_sizes.empty()) {
-    std::cout << "\n[temporal] cuda-temporal on the " << to_string(kind) << " scene, steps per launch k (default "
-              << "tile: the largest square with its 2k-node halo in shared memory), against cuda-fused of the same "
-              << "math and the one-step roofline (64 B per node and step at the copy bandwidth)\n"
+    std::cout << "\n[temporal] cuda-temporal on the " << to_string(kind) << " scene, steps per launch k and tile "
+              << "(default: the largest square whose region, with its 2k-node halo, leaves shared memory for two "
+              << "blocks an SM), against cuda-fused of the same math and the one-step roofline (64 B per node and "
+              << "step at the copy bandwidth)\n"
               << std::setw(8) << "grid" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(4)
-              << "k" << std::setw(12) << "ms/step" << std::setw(12) << "fused" << std::setw(12) << "roofline"
-              << std::setw(14) << "vs roofline" << "\n";
+              << "k" << std::setw(9) << "tile" << std::setw(12) << "ms/step" << std::setw(12) << "fused"
+              << std::setw(12) << "roofline" << std::setw(14) << "vs roofline" << "\n";
     for (int n : o.temporal_sizes) {
       const BenchScene scene(n, kind);
       const double roofline = 64.0 * double(scene.model.node_count()) / (copy_gbs * 1e9) * 1e3;
       for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet})
         for (Math math : {Math::exact, Math::fast}) {
           const double fused = rep.measure("temporal", kind, scene, i, {cuda::Variant::fused, {}, true, math}, o).ms;
-          for (int k : o.steps_per_launch) {
-            cuda::Options t{cuda::Variant::temporal, {}, true, math};
-            t.steps_per_launch = k;
-            const Row r = rep.measure("temporal", kind, scene, i, t, o);
-            std::cout << std::setw(8) << r.grid << std::setw(22) << r.integrator << std::setw(7) << r.math
-                      << std::setw(4) << k << std::setw(12) << fixed(r.ms, 4) << std::setw(12) << fixed(fused, 4)
-                      << std::setw(12) << fixed(roofline, 4) << std::setw(13) << fixed(roofline / r.ms, 2) << "x\n";
-          }
+          for (int k : o.steps_per_launch)
+            for (const std::string& tile : o.temporal_tiles) {
+              cuda::Options t{cuda::Variant::temporal, {}, true, math};
+              t.steps_per_launch = k;
+              if (tile != "default") t.temporal_tile = cuda::parse_temporal_tile(tile);
+              const Row r = rep.measure("temporal", kind, scene, i, t, o);
+              std::cout << std::setw(8) << r.grid << std::setw(22) << r.integrator << std::setw(7) << r.math
+                        << std::setw(4) << k << std::setw(9) << tile << std::setw(12) << fixed(r.ms, 4)
+                        << std::setw(12) << fixed(fused, 4) << std::setw(12) << fixed(roofline, 4) << std::setw(13)
+                        << fixed(roofline / r.ms, 2) << "x\n";
+            }
         }
     }
   }
@@ -230,6 +235,7 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none: skip)");
   c->add_option("--steps-per-launch", o->steps_per_launch, "cuda-temporal's steps per launch to compare")
       ->check(CLI::Range(1, 8));
+  c->add_option("--temporal-tiles", o->temporal_tiles, "cuda-temporal's tiles WxH to compare (default: its own)");
   c->callback([o] { run_cuda(*o); });
 }
 

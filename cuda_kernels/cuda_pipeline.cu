@@ -684,19 +684,27 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   void plan_temporal() {
     const Model& m = model_;
     temporal_ = true;
-    k_ = cuda::steps_per_launch(m, o_);
+    k_ = cuda::steps_per_launch(o_);
     const int halo = 2 * k_;
     const bool volume = m.volume();
     const std::size_t cell = 4 * sizeof(float4);
-    int device = 0, limit = 0;
+    int device = 0, limit = 0, per_sm = 0, reserved = 0;
     check(cudaGetDevice(&device), "finding the device");
     check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
           "reading the shared-memory limit");
+    check(cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device),
+          "reading the shared memory of a multiprocessor");
+    check(cudaDeviceGetAttribute(&reserved, cudaDevAttrReservedSharedMemoryPerBlock, device),
+          "reading the shared memory reserved a block");
     limit -= dev::kStopCheckShared;  // the kernel's own, beside the tile
     temporal_shared_limit_ = limit;
     TemporalTile t = o_.temporal_tile;
-    if (t.x == 0) {  // the largest square or cube
-      const int side = int(std::pow(double(std::size_t(limit) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
+    if (t.x == 0) {
+      // The largest square that leaves room for kTemporalBlocksPerSM blocks an SM; on lattices,
+      // whose halo grows in three axes, the largest cube that fits one.
+      const int blocks = volume ? 1 : dev::kTemporalBlocksPerSM;
+      const int share = std::min(limit, per_sm / blocks - reserved - dev::kStopCheckShared);
+      const int side = int(std::pow(double(std::size_t(share) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
       t = {side, side, volume ? side : 1};
     }
     if (!volume) t.z = 1;

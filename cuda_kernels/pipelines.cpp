@@ -69,8 +69,7 @@ int steps_per_launch_option(const PipelineOptions& o) {
   throw std::invalid_argument("option steps_per_launch '" + it->second + "' is not a count from 1 to 8");
 }
 
-int steps_per_launch(const Model& m, const Options& o) {
-  return o.steps_per_launch > 0 ? o.steps_per_launch : m.volume() ? 2 : 4;
+int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps_per_launch : 2;
 }
 
 std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
@@ -136,7 +135,7 @@ double floor_bytes_per_node(const Model& m, Integrator i, const Options& o) {
                                              : 3 * f4 + links;
   if (s.single_pass()) {
     if (v == Variant::fused) return 4 * f4 + prev + links;  // (x, v) in, (x', v') out
-    if (v == Variant::temporal) return (4 * f4 + 2 * prev) / steps_per_launch(m, o);  // per step, halo not counted
+    if (v == Variant::temporal) return (4 * f4 + 2 * prev) / steps_per_launch(o);  // per step, halo not counted
     return force + 3 * f4 + prev + 2 * f4;                  // update: x, v, a (+ x_prev) in, x', v' out
   }
   double b = 0;

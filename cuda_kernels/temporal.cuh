@@ -10,113 +10,148 @@
 namespace deformlab::cuda::DL_CUDA_MATH::dev {
 
 constexpr int kMaxStepsPerLaunch = 8;
-constexpr int kTemporalThreads = 1024;
+// Threads a block, and the blocks an SM holds at once with the default tile: two, so that one
+// block's loads and stores overlap the other's steps.
+constexpr int kTemporalThreads = 512;
+constexpr int kTemporalBlocksPerSM = 2;
 
 // The drag targets of each step of a launch.
 struct StepTargets {
   Targets step[kMaxStepsPerLaunch];
 };
 
+// A box of region cells: `size` cells from `lo` along each axis.
+struct Box {
+  int3 lo, size;
+};
+
+// a / b for 0 <= a, b < 8192 (a region holds at most 227 KB / 64 B cells), in float and
+// correctly rounded: exact there (checked for every pair), and a few instructions where an
+// integer division takes twenty. rb = __frcp_rn(b).
+__device__ __forceinline__ int small_quotient(int a, float rb) {
+  return __float2int_rz(__fmul_rn(__fadd_rn(float(a), 0.5f), rb));
+}
+
+// Calls f(c) for each cell c of the box, the block's threads taking consecutive cells (along i
+// first: coalesced).
+template <bool Volume, class F>
+__device__ __forceinline__ void for_each_cell(const Box& b, F&& f) {
+  const int count = b.size.x * b.size.y * b.size.z;
+  const float rx = __frcp_rn(float(b.size.x)), ry = __frcp_rn(float(b.size.y));
+  for (int t = threadIdx.x; t < count; t += blockDim.x) {
+    const int row = small_quotient(t, rx);
+    int3 c{t - row * b.size.x, row, 0};
+    if (Volume) {
+      c.z = small_quotient(row, ry);
+      c.y = row - c.z * b.size.y;
+    }
+    f(int3{b.lo.x + c.x, b.lo.y + c.y, b.lo.z + c.z});
+  }
+}
+
 // A block's region: its tile of (tx, ty, tz) nodes at (i, j, k) = block index * tile, and
 // `halo` nodes around it on each side (in k only on lattices).
+template <bool Volume>
 struct Region {
   int3 first;  // grid coordinates of the region's first cell (may be negative)
   int3 cells;  // along each axis
   int halo;
+
+  __device__ Region(int3 tile, int h)
+      : first{int(blockIdx.x) * tile.x - h, int(blockIdx.y) * tile.y - h, int(blockIdx.z) * tile.z - (Volume ? h : 0)},
+        cells{tile.x + 2 * h, tile.y + 2 * h, tile.z + (Volume ? 2 * h : 0)},
+        halo(h) {}
   __device__ int count() const { return cells.x * cells.y * cells.z; }
-  __device__ int3 at(int l) const { return {l % cells.x, (l / cells.x) % cells.y, l / (cells.x * cells.y)}; }
+  __device__ int index(int3 c) const { return (c.z * cells.y + c.y) * cells.x + c.x; }
+  __device__ int node(const StepParams& s, int3 c) const {
+    return P::grid_node(first.x + c.x, first.y + c.y, first.z + c.z, s.nx, s.ny);
+  }
+  // The cells in the grid and `depth` cells in from every side where the region was cut out
+  // of the grid: after step q their state is correct at depth 2 (q + 1).
+  __device__ Box valid(const StepParams& s, int depth) const {
+    auto axis = [](int first, int cells, int n, int d, int& lo, int& size) {
+      lo = first <= 0 ? -first : d;
+      size = max(0, (first + cells >= n ? n - first : cells - d) - lo);
+    };
+    Box b{{0, 0, 0}, {1, 1, 1}};
+    axis(first.x, cells.x, s.nx, depth, b.lo.x, b.size.x);
+    axis(first.y, cells.y, s.ny, depth, b.lo.y, b.size.y);
+    if (Volume) axis(first.z, cells.z, s.nz, depth, b.lo.z, b.size.z);
+    return b;
+  }
+  // The block's own nodes: its tile, within the grid.
+  __device__ Box owned(const StepParams& s) const {
+    auto axis = [](int first, int cells, int n, int h, int& lo, int& size) {
+      lo = h;
+      size = max(0, min(cells - h, n - first) - h);
+    };
+    Box b{{0, 0, 0}, {1, 1, 1}};
+    axis(first.x, cells.x, s.nx, halo, b.lo.x, b.size.x);
+    axis(first.y, cells.y, s.ny, halo, b.lo.y, b.size.y);
+    if (Volume) axis(first.z, cells.z, s.nz, halo, b.lo.z, b.size.z);
+    return b;
+  }
 };
-
-template <bool Volume>
-__device__ __forceinline__ Region block_region(int3 tile, int halo) {
-  const int hz = Volume ? halo : 0;
-  return {{int(blockIdx.x) * tile.x - halo, int(blockIdx.y) * tile.y - halo, int(blockIdx.z) * tile.z - hz},
-          {tile.x + 2 * halo, tile.y + 2 * halo, tile.z + 2 * hz},
-          halo};
-}
-
-// Whether cell c lies in the grid and `depth` cells in from every side where the region was
-// cut out of the grid: after step q its state is correct at depth 2 (q + 1).
-template <bool Volume>
-__device__ __forceinline__ bool cell_valid(const StepParams& s, const Region& r, int3 c, int depth) {
-  auto axis = [](int at, int first, int cells, int n, int d) {
-    const int g = first + at;
-    return g >= 0 && g < n && (first <= 0 || at >= d) && (first + cells >= n || at < cells - d);
-  };
-  return axis(c.x, r.first.x, r.cells.x, s.nx, depth) && axis(c.y, r.first.y, r.cells.y, s.ny, depth) &&
-         axis(c.z, r.first.z, r.cells.z, s.nz, Volume ? depth : 0);
-}
-
-// Whether cell c is one of the block's own nodes (its tile, within the grid).
-template <bool Volume>
-__device__ __forceinline__ bool cell_owned(const StepParams& s, const Region& r, int3 c) {
-  const int hz = Volume ? r.halo : 0;
-  auto own = [](int at, int first, int cells, int h, int n) { return at >= h && at < cells - h && first + at < n; };
-  return own(c.x, r.first.x, r.cells.x, r.halo, s.nx) && own(c.y, r.first.y, r.cells.y, r.halo, s.ny) &&
-         own(c.z, r.first.z, r.cells.z, hz, s.nz);
-}
 
 // Reads (x, v) and x_prev (Verlet), writes k = `steps` steps later (xo, vo) and, for Verlet,
 // the positions one step before those (po). x_prev is not read when has_prev is false.
 // Shared memory: two copies of (x, v) per region cell; Verlet's new positions overwrite the
 // copy holding the previous ones, cell by cell, as in fused_grid.
 template <int N, bool Damped, int Rule>
-__global__ void __launch_bounds__(kTemporalThreads)
+__global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
     temporal_grid(StepParams s, Stencil st, float weight, int steps, int3 tile, const float4* __restrict__ x,
                   const float4* __restrict__ v, const float4* __restrict__ x_prev, bool has_prev,
                   float4* __restrict__ xo, float4* __restrict__ vo, float4* __restrict__ po, StepTargets tg,
                   StopCheck check) {
   constexpr bool kVolume = N > 12, kVerlet = Rule == RULE_VERLET;
   extern __shared__ float4 sh[];
-  const Region r = block_region<kVolume>(tile, 2 * steps);
+  const Region<kVolume> r(tile, 2 * steps);
   const int cells = r.count();
-  float4* sx[2] = {sh, sh + cells};
-  float4* sv[2] = {sh + 2 * cells, sh + 3 * cells};
-  auto node_of = [&](int3 c) { return P::grid_node(r.first.x + c.x, r.first.y + c.y, r.first.z + c.z, s.nx, s.ny); };
-  for (int l = threadIdx.x; l < cells; l += blockDim.x) {
-    const int3 c = r.at(l);
-    if (!cell_valid<kVolume>(s, r, c, 0)) continue;
-    const int g = node_of(c);
-    sx[0][l] = x[g];
-    sv[0][l] = v[g];
-    if (kVerlet && has_prev) sx[1][l] = x_prev[g];
-  }
+  // Copy c of the positions and of the velocities (offsets, not an array of pointers: one
+  // indexed by the step's parity would live in local memory).
+  auto sx = [&](int c) { return sh + c * cells; };
+  auto sv = [&](int c) { return sh + (2 + c) * cells; };
+  for_each_cell<kVolume>(r.valid(s, 0), [&](int3 c) {
+    const int l = r.index(c), g = r.node(s, c);
+    sx(0)[l] = x[g];
+    sv(0)[l] = v[g];
+    if (kVerlet && has_prev) sx(1)[l] = x_prev[g];
+  });
   __syncthreads();
-  float d = 0.f;
   int cur = 0;
   for (int q = 0; q < steps; ++q) {
     const bool prev = has_prev || q > 0;
-    for (int l = threadIdx.x; l < cells; l += blockDim.x) {
-      const int3 c = r.at(l);
-      if (!cell_valid<kVolume>(s, r, c, 2 * (q + 1))) continue;
-      const int i = r.first.x + c.x, j = r.first.y + c.y, k = r.first.z + c.z, node = node_of(c);
-      const float4 x4 = sx[cur][l], v4 = sv[cur][l];
+    for_each_cell<kVolume>(r.valid(s, 2 * (q + 1)), [&](int3 c) {
+      const int i = r.first.x + c.x, j = r.first.y + c.y, k = r.first.z + c.z, l = r.index(c);
+      const int node = P::grid_node(i, j, k, s.nx, s.ny);
+      const float4 x4 = sx(cur)[l], v4 = sv(cur)[l];
       const Vec3f xi = xyz(x4), vi = xyz(v4);
       Vec3f acc{};
       if (!P::node_fixed(s, node, x4.w)) {
-        const Window w{sx[cur], sv[cur], l, r.cells.x, r.cells.x * r.cells.y};
+        const Window w{sx(cur), sv(cur), l, r.cells.x, r.cells.x * r.cells.y};
         acc = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w),
                                    tg.step[q].force);
       }
-      const Vec3f xp = kVerlet && prev ? xyz(sx[1 - cur][l]) : Vec3f{};
+      const Vec3f xp = kVerlet && prev ? xyz(sx(1 - cur)[l]) : Vec3f{};
       Vec3f xn, vn;
       P::one_pass_update(Rule, weight, xi, vi, acc, xp, prev, s.dt, xn, vn);
       P::constrain_node(s, node, x4.w, xi, tg.step[q].end, xn, vn);
-      sx[1 - cur][l] = f4(xn, x4.w);
-      sv[1 - cur][l] = f4(vn, 0.f);
-      if (q == steps - 1 && cell_owned<kVolume>(s, r, c)) d = fmaxf(d, P::displacement(xn, xi, vn));
-    }
+      sx(1 - cur)[l] = f4(xn, x4.w);
+      sv(1 - cur)[l] = f4(vn, 0.f);
+    });
     cur = 1 - cur;
     __syncthreads();
   }
-  for (int l = threadIdx.x; l < cells; l += blockDim.x) {
-    const int3 c = r.at(l);
-    if (!cell_owned<kVolume>(s, r, c)) continue;
-    const int g = node_of(c);
-    xo[g] = sx[cur][l];
-    vo[g] = sv[cur][l];
-    if (kVerlet) po[g] = sx[1 - cur][l];
-  }
+  // The last step's result is in copy cur, its start in the other (Verlet's previous positions).
+  float d = 0.f;
+  for_each_cell<kVolume>(r.owned(s), [&](int3 c) {
+    const int l = r.index(c), g = r.node(s, c);
+    const float4 xn = sx(cur)[l], vn = sv(cur)[l], xs = sx(1 - cur)[l];
+    xo[g] = xn;
+    vo[g] = vn;
+    if (kVerlet) po[g] = xs;
+    d = fmaxf(d, P::displacement(xyz(xn), xyz(xs), xyz(vn)));
+  });
   store_displacement(check, d);
 }
 

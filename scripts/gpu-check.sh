@@ -11,7 +11,8 @@
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
 # timing part's experiment cells again).
-# The build folder can travel as .dev/build.tar.xz (scripts/pack-for-device.sh), unpacked here.
+# The build folder can travel as .dev/*.tar.xz (scripts/pack-for-device.sh: a base and a program an
+# archive), unpacked here.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 for t in .dev/*.tar.xz; do [ -f "$t" ] && xz -dc "$t" | tar -xf -; done

@@ -1,20 +1,28 @@
 #!/usr/bin/env bash
-# Packs a build folder (default build/default) for a GPU machine as .dev/build.tar.xz: binaries
-# (symbols stripped) and test lists, without object files or test logs (the folder itself is too
-# large to travel). scripts/gpu-check.sh unpacks it there, at the same path. EXCLUDE: more
-# patterns to leave out. With .gl/ holding the mesh and window libraries (37 MB), all the
-# binaries (about 5 MB each, packed) do not fit one call's 64 MiB: pack and run a part at a time,
-# e.g. EXCLUDE="deformlab_gl_tests deformlab_viewer_tests deformlab_unit_tests deformlab-bench" with
-# PARTS=tests LABELS='match|cuda|interop', then the rest.
+# Packs a build folder (default build/default) for a GPU machine, one archive a part, so that a
+# call carries only what it runs (.gl/ and every program together exceed one call's 64 MiB):
+#   .dev/base.tar.xz       the tree without object files, test logs or programs (test lists,
+#                          shaders, data)
+#   .dev/<program>.tar.xz  each program, its symbols stripped (about 5 MB each)
+# e.g. carry .gl, .dev/base.tar.xz and .dev/deformlab_cuda_tests.tar.xz, and run
+# `PARTS=tests LABELS=cuda scripts/gpu-check.sh`: it unpacks what .dev/ holds there, at the same
+# paths (ctest's other labels would find their programs missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/default}
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
-excludes=(--exclude='*.o' --exclude='*.a' --exclude='CMakeFiles' --exclude='Testing')
-for e in ${EXCLUDE:-}; do excludes+=(--exclude="$e"); done
-tar -cf - "${excludes[@]}" "$build" | tar -xf - -C "$stage"
-find "$stage" -type f -perm -u+x -exec sh -c 'file -b "$1" | grep -q ELF && strip "$1"' _ {} \;
+tar -cf - --exclude='*.o' --exclude='*.a' --exclude='CMakeFiles' --exclude='Testing' "$build" | tar -xf - -C "$stage"
 mkdir -p .dev
-tar -cf - -C "$stage" "$build" | xz -6 -T2 >.dev/build.tar.xz
-ls -la .dev/build.tar.xz
+programs=()
+while IFS= read -r f; do
+  file -b "$f" | grep -q ELF || continue
+  strip "$f"
+  programs+=("${f#"$stage"/}")
+done < <(find "$stage" -type f -perm -u+x)
+for p in "${programs[@]}"; do
+  tar -cf - -C "$stage" "$p" | xz -6 -T2 >".dev/$(basename "$p").tar.xz"
+  rm "$stage/$p"
+done
+tar -cf - -C "$stage" "$build" | xz -6 -T2 >.dev/base.tar.xz
+ls -la .dev

@@ -196,8 +196,8 @@ TEST(CudaTemporal, OptionsAreChecked) {
   EXPECT_EQ(cuda::parse_temporal_tile("7x5x3").z, 3);
   for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4"})
     EXPECT_THROW(cuda::parse_temporal_tile(bad), std::invalid_argument) << bad;
-  EXPECT_EQ(cuda::steps_per_launch(small_cloth(4, 4), {}), 4);
-  EXPECT_EQ(cuda::steps_per_launch(small_lattice(4, 4, 4), {}), 2);
+  EXPECT_EQ(cuda::steps_per_launch({}), 2);
+  EXPECT_EQ(cuda::steps_per_launch(cuda::Options{Variant::temporal, {}, true, Math::exact, 5}), 5);
   EXPECT_FALSE(cuda::unsupported(Integrator::rk4, Variant::temporal).empty());
   EXPECT_EQ(cuda::unsupported(Integrator::verlet, Variant::temporal), "");
   // What a pipeline tells the run about its launches.

@@ -107,9 +107,9 @@ TEST_F(Cli, TemporalRunNotesChecksThatCutItsLaunches) {
   const Result every = run(args + (dir_ / "every").string());
   if (every.err.find("is not available") != std::string::npos) GTEST_SKIP() << every.err;
   EXPECT_EQ(every.code, 0) << every.err;
-  EXPECT_NE(every.err.find("note: cuda-temporal runs 4 steps a launch; checking the stop rule every 1 step(s)"),
+  EXPECT_NE(every.err.find("note: cuda-temporal runs 2 steps a launch; checking the stop rule every 1 step(s)"),
             std::string::npos) << every.err;
-  const Result whole = run(args + (dir_ / "whole").string() + " --check-every 4");
+  const Result whole = run(args + (dir_ / "whole").string() + " --check-every 2");
   EXPECT_EQ(whole.code, 0) << whole.err;
   EXPECT_EQ(whole.err.find("note:"), std::string::npos) << whole.err;
 }
