@@ -102,6 +102,14 @@ void loglog(const std::filesystem::path& file, const std::string& title, const s
   save(file, b.str());
 }
 
+double tick_step(double top) {
+  const double quarter = top / 4, decade = std::pow(10.0, std::floor(std::log10(quarter)));
+  double step = decade;
+  for (double m : {2.0, 2.5, 5.0})
+    if (m * decade <= quarter) step = m * decade;
+  return step;
+}
+
 void stacked_bars(const std::filesystem::path& file, const std::string& title, const std::string& ylabel,
                   const std::vector<std::string>& part_names, const std::vector<Stack>& bars) {
   double top = 0;
@@ -125,9 +133,12 @@ void stacked_bars(const std::filesystem::path& file, const std::string& title, c
   for (const auto& s : bars) longest = std::max(longest, s.category.size());
   const bool turned = double(longest) * 7 > slot;
   const double height = turned ? kH - kBottom + 12 + double(longest) * 6.5 : kH;
+  const double step = tick_step(top);
+  const int ticks = int(std::ceil(top / step * (1 - 1e-12)));
+  top = ticks * step;
   auto py = [&](double v) { return kH - kBottom - v / top * plot_h; };
-  for (int t = 0; t <= 4; ++t) {
-    const double v = top * t / 4;
+  for (int t = 0; t <= ticks; ++t) {
+    const double v = step * t;
     b << "<line x1=\"" << kLeft << "\" x2=\"" << kW - kRight << "\" y1=\"" << py(v) << "\" y2=\"" << py(v)
       << "\" stroke=\"#ddd\"/><text x=\"" << kLeft - 6 << "\" y=\"" << py(v) + 4 << "\" text-anchor=\"end\">"
       << num(std::round(v * 1000) / 1000) << "</text>\n";

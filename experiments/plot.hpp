@@ -24,4 +24,8 @@ struct Stack {
 void stacked_bars(const std::filesystem::path& file, const std::string& title, const std::string& ylabel,
                   const std::vector<std::string>& part_names, const std::vector<Stack>& bars);
 
+// The step between the gridlines of a linear axis from 0 past `top` (> 0): the largest of 1,
+// 2, 2.5 and 5 times a power of ten that is at most top / 4, so 4 to 8 steps reach it.
+double tick_step(double top);
+
 }  // namespace deformlab::plot
