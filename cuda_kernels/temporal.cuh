@@ -25,9 +25,10 @@ struct Box {
   int3 lo, size;
 };
 
-// a / b for 0 <= a, b < 8192 (a region holds at most 227 KB / 64 B cells), in float and
-// correctly rounded: exact there (checked for every pair), and a few instructions where an
-// integer division takes twenty. rb = __frcp_rn(b).
+// a / b (rounded down) for 0 <= a < 2^21 and b >= 1, given rb = __frcp_rn(b): (a + 0.5) / b
+// lies at least 0.5 / b from an integer, and the two correctly rounded operations move it by
+// at most (a + 0.5) / b * 2^-23, less than that. A few instructions where an integer division
+// takes twenty.
 __device__ __forceinline__ int small_quotient(int a, float rb) {
   return __float2int_rz(__fmul_rn(__fadd_rn(float(a), 0.5f), rb));
 }
