@@ -7,7 +7,7 @@
 # to run, default all but timing, scale, endurance and speed),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
-# LABELS (the tests part's ctest -L regex, default every label),
+# LABELS (the tests part's ctest -L regex, default every label), ARCHIVE (see the end),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
 # timing part's experiment cells again).
@@ -218,6 +218,12 @@ if part endurance; then
   for k in 2 3; do
     summary+=("scatter spread, run 1 vs $k (x y z m, vx vy vz m/s; largest |difference| over 512^2 nodes after 200 steps): $(paste /tmp/scatter1.txt /tmp/scatter$k.txt | awk '{ d = $1 - $2; if (d < 0) d = -d; if (d > m) m = d; if ($1 != $2) c++ } END { printf "%.3g, %d of %d values differ", m, c, NR }')")
   done
+fi
+
+# ARCHIVE=1: the results folder (experiment cells, reports, plots, frames: hundreds of files)
+# as one archive, results.tar.xz, for a transfer that carries few files.
+if [ -n "${ARCHIVE:-}" ] && [ -d "$out/results" ]; then
+  tar -cJf "$out/results.tar.xz" -C "$out" results && rm -rf "$out/results"
 fi
 
 printf '%s\n' "${summary[@]}"
