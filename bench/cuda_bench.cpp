@@ -98,11 +98,14 @@ class Report {
 };
 
 void run_cuda(const CudaOptions& o) {
-  if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
   const Integrator integ = o.integ();
   const SceneKind kind = o.scene_kind();
   std::vector<cuda::Variant> variants;
   for (const auto& v : o.variants) variants.push_back(parse_variant(v));
+  for (const auto& t : o.tiles) cuda::parse_tile(t);  // bad tiles refused before anything runs
+  for (const auto& t : o.temporal_tiles)
+    if (t != "default") cuda::parse_temporal_tile(t);
+  if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
 
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
