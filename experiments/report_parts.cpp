@@ -31,8 +31,14 @@ std::string options_label(const json& o) {
 }
 
 std::string cell_label(const json& c) {
-  if (!c.contains("model")) return std::to_string(c["size"].get<int>()) + "²";
-  return c["model"].get<std::string>() + (c.contains("order") ? " " + c["order"].get<std::string>() : "");
+  std::ostringstream label;  // not string concatenation: GCC 12 warns falsely (-Wrestrict) on that
+  if (!c.contains("model")) {
+    label << c["size"].get<int>() << "²";
+  } else {
+    label << c["model"].get<std::string>();
+    if (c.contains("order")) label << " " << c["order"].get<std::string>();
+  }
+  return label.str();
 }
 
 namespace {

@@ -57,10 +57,16 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
       {"cuda-temporal", {{"tile", "40x"}}},        {"glsl-compute", {{"window", "0"}}},
       {"glsl-tf", {{"link_view", "many"}}},        {"hybrid", {{"interop", "telepathy"}}},
       {"hybrid-compute", {{"force", "fused"}}}};
-  for (const auto& [name, o] : bad)
-    if (r.find(name)->read_options) EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;
-  for (const char* name : {"cuda-temporal", "glsl-compute"})
-    if (r.find(name)->read_options) EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
+  for (const auto& [name, o] : bad) {
+    if (r.find(name)->read_options) {
+      EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;
+    }
+  }
+  for (const char* name : {"cuda-temporal", "glsl-compute"}) {
+    if (r.find(name)->read_options) {
+      EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
+    }
+  }
 }
 
 // The check before a run adds the model, the pipeline's own host bytes and a state, and names

@@ -11,6 +11,7 @@
 #include "experiments/experiment.hpp"
 #include "experiments/pipelines.hpp"
 #include "experiments/report.hpp"
+#include "experiments/report_parts.hpp"
 #include "experiments/sweep.hpp"
 
 namespace deformlab {
@@ -147,6 +148,13 @@ TEST_F(SweepTest, ModelsByOrders) {
 }
 
 // The built-in meshes experiment: 6 models x 4 orders x (7 pipelines + 2 hybrids x 3 force variants).
+// A row's label in the report: the grid size, or the mesh model and its node order.
+TEST(Report, CellLabels) {
+  EXPECT_EQ(report::cell_label(json{{"size", 2048}}), "2048²");
+  EXPECT_EQ(report::cell_label(json{{"model", "sheet-1m"}, {"order", "rcm"}}), "sheet-1m rcm");
+  EXPECT_EQ(report::cell_label(json{{"model", "bunny"}}), "bunny");
+}
+
 TEST_F(SweepTest, MeshesExperimentCells) {
   const Experiment x = load_experiment_by_name("meshes");
   const auto all = cells(*parse_sweep(x.raw, "meshes"));
@@ -195,10 +203,11 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
                 .find("sweep.options.tile: no pipeline of this sweep reads option 'tile'"),
             std::string::npos);
   // A value is read before any cell runs (where this build has the backend that reads it).
-  if (pipelines().find("glsl-compute")->read_options)
+  if (pipelines().find("glsl-compute")->read_options) {
     EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "glsl-compute"], "options": [{"math": "rough"}]})")
                   .find("sweep.options: glsl-compute: option math 'rough' is not exact or fast"),
               std::string::npos);
+  }
 }
 
 TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
