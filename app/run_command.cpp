@@ -204,7 +204,8 @@ int run_command(const RunArgs& a) {
     if (const int k = pipe->steps_per_launch(); k > 1 && in.params.check_every % k != 0)
       std::cerr << "deformlab: note: " << in.entry->name << " runs " << k << " steps a launch; checking the stop rule "
                 << "every " << in.params.check_every << " step(s) launches the steps held at each check, fewer at a "
-                << "time (--check-every " << k << " or a multiple of it keeps every launch whole)\n";
+                << "time, and waits for them (--check-every " << k << " or a multiple of it keeps every launch whole "
+                << "and reads each check while the next launch runs)\n";
     Profiler profiler;
     profiler.stream_csv(dir.staged("spans.csv").string(), a.trace);  // the trace needs them all
     const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);

@@ -32,16 +32,18 @@ class Pipeline {
   // lives; NaN when any position or velocity is not finite.
   virtual double max_displacement() = 0;
   // Checks that do not hold the device up. A pipeline that keeps the state from before its last
-  // step can take that step back (once, until the next step); the run loop then checks step n
-  // while step n + 1 runs and takes n + 1 back when n met the stop rule. queue_displacement()
-  // queues the read of the last step's max_displacement() and returns at once;
-  // take_displacement() waits for it (one read at a time, taken before the step after the next
-  // one). Pipelines that cannot step back need not queue: the run waits at each check.
+  // launch (steps_per_launch() steps) can take that launch back (once, until the next launch);
+  // the run loop then checks step n while the launch after it runs and takes that launch back
+  // when n met the stop rule. queue_displacement() queues the read of the last step's
+  // max_displacement() and returns at once; take_displacement() waits for it (one read at a
+  // time, taken before the launch after the next one). Pipelines that cannot step back need not
+  // queue: the run waits at each check.
   virtual bool can_step_back() const { return false; }
   virtual void step_back() { throw std::logic_error("this pipeline cannot take a step back"); }
   virtual void queue_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
   virtual double take_displacement() { throw std::logic_error("this pipeline does not queue its checks"); }
-  // Steps it queues into one launch (cuda-temporal: k); a check launches the steps held so far.
+  // Steps it queues into one launch (cuda-temporal: k); a check launches the steps held so far
+  // (so a check at a step that ends no launch waits for its step).
   virtual int steps_per_launch() const { return 1; }
   // A timer of this pipeline's steps on the clock of the device that runs them (valid while
   // the pipeline lives). The default: the host clock, for pipelines that step on the host.

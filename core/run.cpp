@@ -55,11 +55,15 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i) {
 
 namespace {
 
-// Each step's time on the pipeline's step clock, filled into the records kBatch steps at a
-// time (reading them waits for the device) and at the end.
+std::size_t whole_launches(int steps, int per_launch) { return std::size_t((steps + per_launch - 1) / per_launch * per_launch); }
+
+// Each step's time on the pipeline's step clock, filled into the records a batch of about 1024
+// steps at a time (reading them waits for the device) and at the end. Reading the times
+// launches the steps a pipeline holds back, so a batch is whole launches.
 class StepTimes {
  public:
-  StepTimes(Pipeline& pipe, RunResult& r, Profiler* prof) : timer_(pipe.step_timer()), r_(r), prof_(prof) {
+  StepTimes(Pipeline& pipe, RunResult& r, Profiler* prof)
+      : timer_(pipe.step_timer()), r_(r), prof_(prof), batch_(whole_launches(1024, pipe.steps_per_launch())) {
     r.clock = timer_->clock();
   }
   void begin() {
@@ -69,7 +73,7 @@ class StepTimes {
   void end() { timer_->end(); }
   // After the step's record is added.
   void after_step() {
-    if (r_.records.size() - filled_ >= kBatch) fill();
+    if (r_.records.size() - filled_ >= batch_) fill();
   }
   void fill() {
     const std::vector<double> ms = timer_->take();
@@ -81,15 +85,15 @@ class StepTimes {
     }
     start_ms_.clear();
   }
-  // Removes the last step's record before its time is read: the run took that step back
-  // (fill() leaves the timer's time of it unread).
-  void drop_last() { r_.records.pop_back(); }
+  // Removes the last steps' records before their times are read: the run took them back
+  // (fill() leaves the timer's times of them unread).
+  void drop_last(int steps) { r_.records.resize(r_.records.size() - std::size_t(steps)); }
 
  private:
-  static constexpr std::size_t kBatch = 1024;
   std::unique_ptr<StepTimer> timer_;
   RunResult& r_;
   Profiler* prof_;
+  std::size_t batch_;  // steps read at a time
   std::size_t filled_ = 0;
   std::vector<double> start_ms_;  // host clock at each pending step's start
 };
@@ -115,9 +119,11 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   const float extent = m.extent();
-  // A check waits for its step only where the pipeline cannot step back or each step is
-  // looked at (after_step); else it is read while the next step runs (Pipeline::step_back).
-  const bool lagged = pipe.can_step_back() && !opt.after_step;
+  // A check waits for its step where the pipeline cannot step back, each step is looked at
+  // (after_step) or checks fall between launches; else it is read while the next launch runs
+  // (Pipeline::step_back), that is `launch` steps later.
+  const int launch = pipe.steps_per_launch();
+  const bool lagged = pipe.can_step_back() && !opt.after_step && p.check_every % launch == 0;
   int queued = 0;  // the step whose check is queued (lagged), else 0
   // Records a checked step's displacement; true when the run stops there.
   auto stops_at = [&](int step, double disp) {
@@ -144,7 +150,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     r.steps = step;
     r.records.push_back({step, step * double(p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
                          std::numeric_limits<double>::quiet_NaN()});
-    if (queued) {  // the previous step's check, read while this step runs
+    if (queued && step == queued + launch) {  // the check before this launch, read while it runs
       const int checked = std::exchange(queued, 0);
       bool met = false;
       try {
@@ -156,7 +162,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
       }
       if (met) {
         pipe.step_back();
-        times.drop_last();
+        times.drop_last(launch);
         r.steps = checked;
         r.converged = true;
         break;
@@ -164,7 +170,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     }
     const bool check = step % p.check_every == 0 || step == p.max_steps;
     bool stop = false;
-    if (check && lagged && step < p.max_steps) {
+    if (check && lagged && step + launch <= p.max_steps) {
       pipe.queue_displacement();
       queued = step;
     } else if (check) {

@@ -410,9 +410,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     } else {
       enqueue_step();
     }
-    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     back_t_ = t_;
+    back_has_prev_ = has_prev_;
     back_ = Back::possible;
+    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
     t_ += p_.dt;
     stepped_ = true;
@@ -420,14 +421,16 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     ++result_launches_;
   }
 
-  // The one-step kernels read state cur_ and write the other; Verlet's overwrite the positions
-  // before it, cuda-temporal's advance k steps.
-  bool can_step_back() const override { return !temporal_ && sched_.rule != UpdateRule::verlet; }
+  // The kernels read state cur_ and write the other, so the state before the last launch stays
+  // until the next; but the one-step Verlet kernels overwrite the positions before it
+  // (cuda-temporal keeps them in prev_).
+  bool can_step_back() const override { return temporal_ || sched_.rule != UpdateRule::verlet; }
   int steps_per_launch() const override { return temporal_ ? k_ : 1; }
   void step_back() override {
-    if (!can_step_back() || back_ != Back::possible) throw std::logic_error("cuda pipeline: no step to take back");
+    if (!can_step_back() || back_ != Back::possible) throw std::logic_error("cuda pipeline: no launch to take back");
     cur_ = 1 - cur_;
     t_ = back_t_;
+    has_prev_ = back_has_prev_;
     back_ = Back::taken;
     // The launch taken back added into the word the next launch from this state adds into.
     check(cudaMemsetAsync(stop_.get() + cur_, 0, sizeof(unsigned), stream_), "clearing the stop rule's reduction");
@@ -735,6 +738,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     held_t_[pending_++] = t_;
     t_ += p_.dt;
     stepped_ = true;
+    back_ = Back::none;  // until these steps are launched
     if (pending_ == k_) flush();
   }
   // Launches the held steps, if any (before anything reads the state or its step times).
@@ -748,6 +752,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
         case UpdateRule::backward_euler: throw std::logic_error("cuda-temporal step for backward Euler");
       }
     }, pending_);
+    back_t_ = held_t_[0];
+    back_has_prev_ = has_prev_;
+    back_ = Back::possible;
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
     launched_ += pending_;
@@ -831,7 +838,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back
-  double back_t_ = 0.0;  // t_ before the last step
+  double back_t_ = 0.0;         // t_ before the last launch
+  bool back_has_prev_ = false;  // has_prev_ before it
   std::int64_t launched_ = 0;  // steps queued on the device
 
   // cuda-temporal: steps are held back until a launch can take steps_per_launch of them (or

@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "cuda_kernels/pipelines.hpp"
@@ -126,6 +127,33 @@ TEST(CudaTemporal, FindsANonFiniteState) {
     auto t = cuda::make_pipeline({m, small_params(), Integrator::semi_implicit_euler}, temporal(k, {8, 6, 1}, Math::exact));
     advance(*t, s0, 2 * k);
     EXPECT_TRUE(std::isnan(t->max_displacement())) << "k=" << k;
+  }
+}
+
+// A launch taken back (the run loop's lagged checks) leaves the state before it, previous
+// positions included (Verlet keeps them in their own ping-pong buffers), and the launches
+// after it go on as if it had not been; a launch still held, or one taken back, cannot be.
+TEST(CudaTemporal, TakesTheLastLaunchBack) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const ContactScene sc = contact_scene(small_cloth(37, 53), false);
+  for (Integrator integ : kOnePass) {
+    const std::string what(info(integ).name);
+    auto t = cuda::make_pipeline({sc.m, sc.p, integ}, temporal(3, {8, 6, 1}, Math::exact));
+    auto twin = cuda::make_pipeline({sc.m, sc.p, integ}, temporal(3, {8, 6, 1}, Math::exact));
+    const State s0 = perturbed_state(sc.m, 9u);
+    ASSERT_TRUE(t->can_step_back()) << what;
+    const State one = advance(*twin, s0, 3);
+    advance(*t, s0, 6);
+    t->step_back();
+    EXPECT_TRUE(bitwise_equal(t->state(), one)) << what;
+    EXPECT_THROW(t->step_back(), std::logic_error) << what;
+    t->step();
+    EXPECT_THROW(t->step_back(), std::logic_error) << what << ": two steps still held";
+    t->step();
+    t->step();
+    for (int k = 0; k < 3; ++k) twin->step();
+    EXPECT_TRUE(bitwise_equal(t->state(), twin->state())) << what;
+    EXPECT_EQ(t->max_displacement(), twin->max_displacement()) << what;
   }
 }
 

@@ -153,26 +153,34 @@ TEST(Run, CheckEveryKStepsStillCatchesDivergence) {
   }
 }
 
-// A CPU pipeline that can take its last step back, as the GPU pipelines do: the lagged
-// checks must give the run the same end as checks that wait.
+// A CPU pipeline that can take its last launch back, as the GPU pipelines do, with `per_launch`
+// steps a launch (cuda-temporal's k): the lagged checks must give the run the same end as checks
+// that wait. It checks that the run loop queues checks and takes launches back only where a
+// launch ends.
 class SteppingBack final : public Pipeline {
  public:
-  SteppingBack(std::unique_ptr<Pipeline> p, bool can) : p_(std::move(p)), can_(can) {}
+  SteppingBack(std::unique_ptr<Pipeline> p, bool can, int per_launch)
+      : p_(std::move(p)), can_(can), per_launch_(per_launch) {}
   void set_state(const State& s) override { p_->set_state(s); }
   State state() override { return p_->state(); }
   void step() override {
-    before_ = p_->state();
+    if (steps_ % per_launch_ == 0) before_ = p_->state();
     p_->step();
+    ++steps_;
   }
   void set_drag(const DragHandle& d) override { p_->set_drag(d); }
   double max_displacement() override { return p_->max_displacement(); }
   bool can_step_back() const override { return can_; }
+  int steps_per_launch() const override { return per_launch_; }
   void step_back() override {
-    ASSERT_TRUE(before_.has_value()) << "step taken back twice";
+    ASSERT_EQ(steps_ % per_launch_, 0) << "a launch taken back before it ended";
+    ASSERT_TRUE(before_.has_value()) << "launch taken back twice";
     p_->set_state(*std::exchange(before_, std::nullopt));
+    steps_ -= per_launch_;
     ++taken_back;
   }
   void queue_displacement() override {
+    EXPECT_EQ(steps_ % per_launch_, 0) << "a check queued within a launch";
     queued_.push_back(p_->max_displacement());
     ++queues;
   }
@@ -186,7 +194,9 @@ class SteppingBack final : public Pipeline {
  private:
   std::unique_ptr<Pipeline> p_;
   bool can_;
-  std::optional<State> before_;
+  int per_launch_;
+  int steps_ = 0;
+  std::optional<State> before_;  // the state before the last launch
   std::deque<double> queued_;
 };
 
@@ -196,8 +206,8 @@ struct Ended {
   int diverged_at = 0, queues = 0, taken_back = 0;
 };
 
-Ended run_checked(const Model& m, const Params& p, Integrator i, bool can_step_back) {
-  SteppingBack pipe(make_cpu_pipeline({m, p, i}, Precision::f32, false), can_step_back);
+Ended run_checked(const Model& m, const Params& p, Integrator i, bool can_step_back, int per_launch = 1) {
+  SteppingBack pipe(make_cpu_pipeline({m, p, i}, Precision::f32, false), can_step_back, per_launch);
   Ended e;
   try {
     e.r = run(pipe, m, p, {.until_converged = true, .integrator = i});
@@ -227,13 +237,18 @@ void expect_same_end(const Ended& lagged, const Ended& waited) {
   }
 }
 
-TEST(Run, LaggedChecksEndWhereWaitingChecksEnd) {
-  const Model m = test::small_cloth(12, 12);
+Params settling_params() {
   Params p = test::small_params();
   p.damping = 0.5f;
   p.threshold = 1e-5f;
   p.max_steps = 50000;
   p.min_steps = 50;
+  return p;
+}
+
+TEST(Run, LaggedChecksEndWhereWaitingChecksEnd) {
+  const Model m = test::small_cloth(12, 12);
+  Params p = settling_params();
   for (int every : {1, 3}) {
     p.check_every = every;
     const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true);
@@ -249,16 +264,50 @@ TEST(Run, LaggedChecksEndWhereWaitingChecksEnd) {
   expect_same_end(lagged, run_checked(m, p, Integrator::semi_implicit_euler, false));
 }
 
+// Several steps a launch: a check at a launch's end is read while the next launch runs, and the
+// stop takes that whole launch back.
+TEST(Run, LaggedChecksOverLaunchesEndWhereWaitingChecksEnd) {
+  const Model m = test::small_cloth(12, 12);
+  Params p = settling_params();
+  for (int per_launch : {2, 3}) {
+    for (int every : {per_launch, 2 * per_launch}) {
+      p.check_every = every;
+      const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true, per_launch);
+      const Ended waited = run_checked(m, p, Integrator::semi_implicit_euler, false, per_launch);
+      ASSERT_TRUE(waited.r.converged) << per_launch << " a launch, every " << every;
+      EXPECT_EQ(lagged.taken_back, 1) << per_launch << " a launch, every " << every;
+      EXPECT_EQ(lagged.r.steps % every, 0);
+      expect_same_end(lagged, waited);
+    }
+  }
+  // Checks that fall within launches wait for their steps.
+  p.check_every = 3;
+  const Ended within = run_checked(m, p, Integrator::semi_implicit_euler, true, 2);
+  EXPECT_EQ(within.queues, 0);
+  EXPECT_EQ(within.taken_back, 0);
+  EXPECT_TRUE(within.r.converged);
+  // A budget that ends within a launch: the checks of its last launch wait.
+  p.check_every = 2;
+  p.max_steps = 41;
+  const Ended budget = run_checked(m, p, Integrator::semi_implicit_euler, true, 2);
+  EXPECT_EQ(budget.taken_back, 0);
+  EXPECT_EQ(budget.r.steps, 41);
+  expect_same_end(budget, run_checked(m, p, Integrator::semi_implicit_euler, false, 2));
+}
+
 TEST(Run, LaggedChecksCatchDivergenceAtTheSameStep) {
   const Model m = test::small_cloth(10, 10);
   Params p = test::small_params();
   p.dt = float(3 * stability_limit(m, p, Integrator::semi_implicit_euler));
   p.max_steps = 5000;
-  const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true);
-  const Ended waited = run_checked(m, p, Integrator::semi_implicit_euler, false);
-  ASSERT_GT(waited.diverged_at, 0);
-  EXPECT_EQ(lagged.taken_back, 1);
-  expect_same_end(lagged, waited);
+  for (int per_launch : {1, 2}) {
+    p.check_every = per_launch;
+    const Ended lagged = run_checked(m, p, Integrator::semi_implicit_euler, true, per_launch);
+    const Ended waited = run_checked(m, p, Integrator::semi_implicit_euler, false, per_launch);
+    ASSERT_GT(waited.diverged_at, 0);
+    EXPECT_EQ(lagged.taken_back, 1);
+    expect_same_end(lagged, waited);
+  }
 }
 
 }  // namespace
