@@ -70,27 +70,24 @@ struct Region {
   // The cells in the grid and `depth` cells in from every side where the region was cut out
   // of the grid: after step q their state is correct at depth 2 (q + 1).
   __device__ Box valid(const StepParams& s, int depth) const {
-    auto axis = [](int first, int cells, int n, int d, int& lo, int& size) {
-      lo = first <= 0 ? -first : d;
-      size = max(0, (first + cells >= n ? n - first : cells - d) - lo);
-    };
-    Box b{{0, 0, 0}, {1, 1, 1}};
-    axis(first.x, cells.x, s.nx, depth, b.lo.x, b.size.x);
-    axis(first.y, cells.y, s.ny, depth, b.lo.y, b.size.y);
-    if (Volume) axis(first.z, cells.z, s.nz, depth, b.lo.z, b.size.z);
-    return b;
+    return per_axis(s, [depth](int first, int cells, int n) {
+      const int lo = first <= 0 ? -first : depth;
+      return int2{lo, max(0, (first + cells >= n ? n - first : cells - depth) - lo)};
+    });
   }
   // The block's own nodes: its tile, within the grid.
   __device__ Box owned(const StepParams& s) const {
-    auto axis = [](int first, int cells, int n, int h, int& lo, int& size) {
-      lo = h;
-      size = max(0, min(cells - h, n - first) - h);
-    };
-    Box b{{0, 0, 0}, {1, 1, 1}};
-    axis(first.x, cells.x, s.nx, halo, b.lo.x, b.size.x);
-    axis(first.y, cells.y, s.ny, halo, b.lo.y, b.size.y);
-    if (Volume) axis(first.z, cells.z, s.nz, halo, b.lo.z, b.size.z);
-    return b;
+    return per_axis(s, [h = halo](int first, int cells, int n) { return int2{h, max(0, min(cells - h, n - first) - h)}; });
+  }
+
+ private:
+  // The box whose extent along each axis is axis(first, cells, grid size) = (lo, size); one cell
+  // along k on cloths.
+  template <class Axis>
+  __device__ Box per_axis(const StepParams& s, Axis axis) const {
+    const int2 x = axis(first.x, cells.x, s.nx), y = axis(first.y, cells.y, s.ny);
+    const int2 z = Volume ? axis(first.z, cells.z, s.nz) : int2{0, 1};
+    return {{x.x, y.x, z.x}, {x.y, y.y, z.y}};
   }
 };
 
