@@ -114,10 +114,11 @@ JSON
     cell=$(ls "$out"/results/clock-check/cells/*"$p"* 2>/dev/null | head -1)
     summary+=("timing $p 2048^2 paper scene, ms/step: run $(median_of median_step_ms "$out/timing-run-$p.json"), cell $(median_of median_ms "$cell")")
   done
-  # Three runs each of 2000 steps; "/fast": math=fast.
-  for pm in cuda-fused cuda-fused/fast glsl-compute glsl-tf hybrid-compute; do
+  # Three runs each of 2000 steps; "/fast": math=fast; cuda-temporal checks at each launch (2 steps).
+  for pm in cuda-fused cuda-fused/fast cuda-temporal glsl-compute glsl-tf hybrid-compute; do
     p=${pm%/*}; opt=(); [ "$pm" != "$p" ] && opt=(--option math=fast)
-    for every in 1 2000; do
+    first=1; [ "$p" = cuda-temporal ] && first=2
+    for every in $first 2000; do
       walls=""
       for rep in 1 2 3; do
         "$app" run --experiment table2 --pipeline "$p" "${opt[@]}" --grid 2048x2048 --steps 2000 --check-every "$every" \
