@@ -145,7 +145,7 @@ void write_stage_group(std::ostringstream& md, const fs::path& dir, const std::s
   std::string file = "stages-" + g.label + ".svg";
   for (char& ch : file)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '.') ch = '_';
-  plot::stacked_bars(dir / file, name + ": " + g.label, "% of the step", parts, bars);
+  plot::stacked_bars(dir / file, name + ": " + g.label, "% of the timed step (stages profiled apart)", parts, bars);
   md << "\n![" << g.label << " stages](" << file << ")\n\n";
 }
 
@@ -190,7 +190,9 @@ void write_stages(std::ostringstream& md, const fs::path& dir, const std::string
   md << "## Where a step's time goes\n\n"
         "Stage times are medians per step over one more batch run with the profiler attached, each by its own "
         "clock (CUDA events, GL timer queries); \"rest\" is the timed step less its GPU stages: hand-offs, "
-        "waits and launch gaps. Host-clock columns are CPU time inside those calls.";
+        "waits and launch gaps. Host-clock columns are CPU time inside those calls. The stages run one launch "
+        "at a time there, where the timed steps may replay a graph, so at small sizes they can add up to more "
+        "than the step (bars past 100%).";
   if (ceil.any()) md << " In brackets: the stage's ceiling / its time (ceilings.hpp; 100% = at the ceiling).";
   md << "\n\n";
   for (const Group& g : groups) write_stage_group(md, dir, name, g, ceil);
