@@ -410,14 +410,20 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     } else {
       enqueue_step();
     }
-    back_t_ = t_;
+    end_launch(1, t_);
+    t_ += p_.dt;
+    stepped_ = true;
+  }
+
+  // After a launch of `steps` steps from time t_before: the state it wrote becomes current, and
+  // the one before it what step_back returns to.
+  void end_launch(int steps, double t_before) {
+    back_t_ = t_before;
     back_has_prev_ = has_prev_;
     back_ = Back::possible;
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
     cur_ = 1 - cur_;
-    t_ += p_.dt;
-    stepped_ = true;
-    ++launched_;
+    launched_ += steps;
     ++result_launches_;
   }
 
@@ -752,13 +758,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
         case UpdateRule::backward_euler: throw std::logic_error("cuda-temporal step for backward Euler");
       }
     }, pending_);
-    back_t_ = held_t_[0];
-    back_has_prev_ = has_prev_;
-    back_ = Back::possible;
-    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
-    cur_ = 1 - cur_;
-    launched_ += pending_;
-    ++result_launches_;
+    end_launch(pending_, held_t_[0]);
     pending_ = 0;
   }
   template <int Rule>
