@@ -25,7 +25,23 @@ parts=${PARTS:-tests sanitizers bench experiments}
 app="$build/app/deformlab"
 part() { [[ " $parts " == *" $1 "* ]]; }
 
+# The tests part refuses to start when a program its tests run is not here (a .dev archive not
+# carried; ctest then lists such a test without a command): the gl, viewer and cli tests also
+# start deformlab itself.
 if part tests; then
+  missing=()
+  while IFS='|' read -r prog name; do
+    [ -z "$prog" ] && missing+=("the program of $name")
+    case $prog in *_gl_tests | *_viewer_tests | *_cli_tests) [ -x "$app" ] || missing+=("$app") ;; esac
+  done < <(ctest --test-dir "$build" ${LABELS:+-L "$LABELS"} --show-only=json-v1 | awk '
+    /^    \{/ { prog = "" }
+    /^      "command" :/ { getline; getline; prog = $0; sub(/^ *"/, "", prog); sub(/",?$/, "", prog) }
+    /^      "name" :/ { name = $0; sub(/^ *"name" : "/, "", name); sub(/",?$/, "", name); print prog "|" name }')
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "gpu-check: the tests part needs what is not here: $(printf '%s\n' "${missing[@]}" | sort -u | head -3 |
+      paste -sd ';' | sed 's/;/; /g') (carry the .dev archives of their programs: scripts/pack-for-device.sh)" >&2
+    exit 2
+  fi
   ctest --test-dir "$build" -j"${JOBS:-4}" ${LABELS:+-L "$LABELS"} --output-on-failure >"$out/ctest.log" 2>&1
   summary+=("ctest: $(grep -E 'tests passed|tests failed' "$out/ctest.log" | tail -1)")
   grep -E "Label|^ *(unit|match|gl|cuda|interop|viewer) *=" "$out/ctest.log" >>"$out/ctest-labels.txt"

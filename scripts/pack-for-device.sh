@@ -6,8 +6,8 @@
 #   .dev/<program>.tar.xz  each program, its symbols stripped (about 5 MB each)
 # e.g. carry .gl, .dev/base.tar.xz and .dev/deformlab_cuda_tests.tar.xz, and run
 # `PARTS=tests LABELS=cuda scripts/gpu-check.sh`: it unpacks what .dev/ holds there, at the same
-# paths (ctest's other labels would find their programs missing; a few gl and viewer tests run
-# deformlab itself, so carry .dev/deformlab.tar.xz with those labels).
+# paths, and refuses to start when a chosen test's program is missing (the gl, viewer and cli
+# tests run deformlab itself, so carry .dev/deformlab.tar.xz with those labels).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/default}

@@ -20,7 +20,7 @@ struct Command {
 };
 
 Command run_deformlab(const std::string& env, const std::string& args) {
-  const std::string cmd = env + " '" DEFORMLAB_BIN "' " + args + " 2>&1";
+  const std::string cmd = env + " '" DEFORMLAB_EXE "' " + args + " 2>&1";
   FILE* f = ::popen(cmd.c_str(), "r");
   if (!f) return {-1, "popen failed"};
   std::string out;
