@@ -114,5 +114,18 @@ TEST_F(Cli, TemporalRunNotesChecksThatCutItsLaunches) {
   EXPECT_EQ(whole.err.find("note:"), std::string::npos) << whole.err;
 }
 
+TEST_F(Cli, TemporalRunNotesThatLatticesRunFasterOnCudaFused) {
+  const std::string args = "run --pipeline cuda-temporal --integrator semi-implicit-euler --steps 4 --check-every 2 "
+                           "--no-state --out ";
+  const Result lattice = run(args + (dir_ / "lattice").string() + " --lattice 9x8x7");
+  if (lattice.err.find("is not available") != std::string::npos) GTEST_SKIP() << lattice.err;
+  EXPECT_EQ(lattice.code, 0) << lattice.err;
+  EXPECT_NE(lattice.err.find("note: on lattices cuda-temporal took longer a step than cuda-fused"), std::string::npos)
+      << lattice.err;
+  const Result cloth = run(args + (dir_ / "cloth").string() + " --grid 24x24");
+  EXPECT_EQ(cloth.code, 0) << cloth.err;
+  EXPECT_EQ(cloth.err.find("note:"), std::string::npos) << cloth.err;
+}
+
 }  // namespace
 }  // namespace deformlab::test
