@@ -1,19 +1,18 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
 // and the device reductions (displacement, energy); and its force pass on its own, the CUDA
-// stage of the hybrid pipelines. One translation unit: kernels.cuh defines the kernels. It is
-// compiled once per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
+// stage of the hybrid pipelines. One translation unit: kernels.cuh and temporal.cuh define the
+// kernels, force_kernels.cuh the model on the device and the force pass. It is compiled once
+// per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
 #include <thrust/execution_policy.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/transform_reduce.h>
 
 #include <algorithm>
-#include <functional>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
-#include <type_traits>
 #include <utility>
 #include <vector>
 #include <stdexcept>
@@ -21,8 +20,8 @@
 #include "check.cuh"
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
+#include "force_kernels.cuh"
 #include "force_pass.hpp"
-#include "core/partition.hpp"
 #include "core/stage.hpp"
 #include "core/step_params.hpp"
 #include "kernels.cuh"
@@ -31,182 +30,6 @@
 
 namespace deformlab::cuda::DL_CUDA_MATH {
 namespace {
-
-using dev::Link;
-using dev::P;
-using dev::Spring;
-using dev::Stencil;
-using dev::Targets;
-
-constexpr int kBlock = 256;  // threads per block of the one-dimensional kernels
-
-unsigned blocks_for(std::int64_t n) { return unsigned((n + kBlock - 1) / kBlock); }
-
-// Throws std::invalid_argument when the tile is not a block shape or the grid exceeds the
-// launch limits with it.
-void check_tile(const Model& m, const Tile& t) {
-  if (t.x < 1 || t.y < 1 || t.x * t.y > 1024)
-    throw std::invalid_argument("CUDA tile " + std::to_string(t.x) + "x" + std::to_string(t.y) +
-                                " is not a valid block shape (1..1024 threads)");
-  if (m.topology == Topology::general) return;
-  if ((m.ny + t.y - 1) / t.y > 65535 || m.nz > 65535)
-    throw std::invalid_argument("grid of " + std::to_string(m.ny) + " rows / " + std::to_string(m.nz) +
-                                " layers exceeds the CUDA launch limits for tile height " + std::to_string(t.y));
-}
-
-// The model and scene on the device as the kernels see them (scene, stencil or adjacency,
-// springs, spheres) and the force pass of the gather and scatter variants: the base of the
-// CUDA pipeline and, on its own, the force stage of the hybrid pipelines.
-class ForceKernels {
- public:
-  ForceKernels(const Model& m, const Params& p, const Options& o)
-      : model_(m), o_(o), sp_(step_params<float>(m, p)) {
-    damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
-    if (m.grid()) {
-      const auto entries = stencil_entries<float>(m);
-      std::copy(entries.begin(), entries.end(), stencil_.e);
-    } else if (o_.variant == Variant::tiled) {
-      upload_tiling();
-    } else if (o_.variant != Variant::scatter) {
-      upload(offset_, m.adj_offset, "uploading the adjacency offsets");
-      upload(links_, links_of(m.adj_node, m.adj_spring), "uploading the adjacency");
-    }
-    if (o_.variant == Variant::scatter && !m.grid()) upload_springs();
-  }
-
-  // acc = a(x, v) for every node, queued on `stream`.
-  void launch_forces(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
-    if (o_.variant == Variant::scatter) {
-      check(cudaMemsetAsync(acc, 0, std::size_t(sp_.node_count) * sizeof(float4), stream), "clearing the force sums");
-      const std::int64_t s = std::int64_t(springs_.size());
-      if (model_.grid()) {
-        with_grid_flags([&](auto n, auto) {
-          const std::int64_t threads = std::int64_t(sp_.node_count) * (n() / 2);
-          dev::scatter_grid<n()><<<blocks_for(threads), kBlock, 0, stream>>>(sp_, stencil_, x, v, acc);
-        });
-        check_launch("launching the grid scatter kernel");
-      } else if (s > 0) {
-        dev::scatter_springs<<<blocks_for(s), kBlock, 0, stream>>>(springs_.get(), s, x, v, acc);
-        check_launch("launching the scatter kernel");
-      }
-      dev::scatter_finish<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, x, v, acc, target);
-      check_launch("launching the scatter finishing kernel");
-      return;
-    }
-    if (!model_.grid() && o_.variant == Variant::tiled) {
-      const dev::TiledCsr t{tile_offset_.get(), tile_node_.get(), members_.get(), offset_.get(), links_.get()};
-      if (damped_) dev::force_tiled_csr<true><<<tiles_, tile_threads_, tile_shared_, stream>>>(sp_, t, x, v, acc, target);
-      else dev::force_tiled_csr<false><<<tiles_, tile_threads_, tile_shared_, stream>>>(sp_, t, x, v, acc, target);
-      check_launch("launching the tiled mesh force kernel");
-      return;
-    }
-    if (!model_.grid()) {
-      dev::force_csr<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, offset_.get(), links_.get(), x, v, acc,
-                                                                        target);
-      check_launch("launching the CSR gather force kernel");
-      return;
-    }
-    const bool tiled = o_.variant == Variant::tiled;
-    with_grid_flags([&](auto n, auto damped) {
-      if (tiled) launch_force_grid<n(), damped(), true>(x, v, acc, target, stream);
-      else launch_force_grid<n(), damped(), false>(x, v, acc, target, stream);
-    });
-  }
-
- protected:
-  // Synchronous: done before any work is queued (or, for the springs, before they are read).
-  template <class T>
-  void upload(Buffer<T>& b, const std::vector<T>& h, const char* what) {
-    b.allocate(h.size(), what);
-    if (!h.empty()) check(cudaMemcpy(b.get(), h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice), what);
-  }
-  // One link per CSR entry: `node` (another node, or a cell of a tile) and spring's constants.
-  std::vector<Link> links_of(const std::vector<std::int32_t>& node, const std::vector<std::int32_t>& spring) const {
-    std::vector<Link> links(node.size());
-    for (std::size_t e = 0; e < links.size(); ++e)
-      links[e] = {node[e], model_.rest_length[spring[e]], model_.spring_k(spring[e]), model_.spring_kd(spring[e])};
-    return links;
-  }
-  // cuda-tiled on a general model: one thread block per tile of tile.x * tile.y nodes
-  // (core/partition.hpp), the tile's positions (and velocities) in shared memory.
-  void upload_tiling() {
-    const Tiling t = tile_model(model_, o_.tile.x * o_.tile.y);
-    const std::vector<Link> links = links_of(t.link_cell, t.link_spring);
-    damped_ = std::any_of(links.begin(), links.end(), [](const Link& l) { return l.kd != 0.f; });
-    tiles_ = unsigned(t.blocks());
-    tile_threads_ = unsigned(o_.tile.x * o_.tile.y);
-    tile_shared_ = std::size_t(t.largest_tile()) * sizeof(float4) * (damped_ ? 2 : 1);
-    int device = 0, limit = 0;
-    check(cudaGetDevice(&device), "finding the device");
-    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device), "reading the shared-memory limit");
-    if (tile_shared_ > std::size_t(limit))
-      throw std::invalid_argument("cuda-tiled: the largest tile of " + std::to_string(t.largest_tile()) + " nodes needs " +
-                                  std::to_string(tile_shared_) + " bytes of shared memory; this device allows " +
-                                  std::to_string(limit) + " (choose a smaller tile)");
-    for (const auto kernel : {dev::force_tiled_csr<true>, dev::force_tiled_csr<false>})
-      check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(tile_shared_)),
-            "raising the tiled kernel's shared-memory limit");
-    upload(tile_offset_, t.tile_offset, "uploading the tiles");
-    upload(tile_node_, t.tile_node, "uploading the tiles' nodes");
-    upload(members_, t.members, "uploading the tiles' member counts");
-    upload(offset_, t.link_offset, "uploading the tiles' adjacency offsets");
-    upload(links_, links, "uploading the tiles' adjacency");
-  }
-  void upload_springs() {
-    const Model& m = model_;  // general models (grids have no spring list)
-    std::vector<Spring> sp(m.spring_count());
-    for (std::size_t e = 0; e < sp.size(); ++e)
-      sp[e] = {m.spring_i[e], m.spring_j[e], m.rest_length[e], m.spring_k(int(e)), m.spring_kd(int(e))};
-    require_device_memory(std::int64_t(sp.size() * sizeof(Spring)), "the spring list");
-    upload(springs_, sp, "uploading the spring list");
-  }
-  dim3 grid_blocks() const {
-    return dim3(unsigned((sp_.nx + o_.tile.x - 1) / o_.tile.x), unsigned((sp_.ny + o_.tile.y - 1) / o_.tile.y),
-                unsigned(sp_.nz));
-  }
-  dim3 grid_threads() const { return dim3(unsigned(o_.tile.x), unsigned(o_.tile.y), 1); }
-
-  // Calls f(N, Damped) with the grid kernels' compile-time flags for this model.
-  template <class F>
-  void with_grid_flags(F&& f) const {
-    using std::bool_constant;
-    using std::integral_constant;
-    auto damp = [&](auto n) {
-      if (damped_) f(n, bool_constant<true>{});
-      else f(n, bool_constant<false>{});
-    };
-    if (model_.volume()) damp(integral_constant<int, kLatticeStencil>{});
-    else damp(integral_constant<int, kClothStencil>{});
-  }
-
-  template <int N, bool Damped, bool Tiled>
-  void launch_force_grid(const float4* x, const float4* v, float4* acc, Vec3f target, cudaStream_t stream) const {
-    const auto kernel = dev::force_grid<N, Damped, Tiled>;
-    std::size_t shared = 0;
-    if (Tiled) {
-      const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
-                                (N > 12 ? 2 * dev::kHalo + 1 : 1);
-      shared = cells * sizeof(float4) * (Damped ? 2 : 1);
-      if (shared > 48 * 1024)
-        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
-              "raising the tiled kernel's shared-memory limit");
-    }
-    kernel<<<grid_blocks(), grid_threads(), shared, stream>>>(sp_, stencil_, x, v, acc, target);
-    check_launch(Tiled ? "launching the tiled force kernel" : "launching the gather force kernel");
-  }
-
-  const Model& model_;
-  Options o_;
-  bool damped_ = false;
-  dev::StepParams sp_;
-  Stencil stencil_{};
-  Buffer<int> offset_;  // CSR offsets: per node, or per tile cell (cuda-tiled)
-  Buffer<Link> links_;
-  Buffer<int> tile_offset_, tile_node_, members_;  // cuda-tiled on general models
-  unsigned tiles_ = 0, tile_threads_ = 0;
-  std::size_t tile_shared_ = 0;
-  Buffer<Spring> springs_;
-};
 
 using PD = Physics<double>;
 __host__ __device__ Vec3d widen(const Vec3f& a) { return {a.x, a.y, a.z}; }
@@ -251,71 +74,6 @@ struct GridSpringEnergyOp {
     }
     return e;
   }
-};
-
-// Steps timed back to back by one CUDA event at each step's end (and one before the first step
-// after a take): a step's time runs from the end of the step before to its own, as the device
-// ran them, idle time between them included. A pair of events around each step would instead
-// add the device's launch latency to every step replayed from a graph (10 us of 130 at 2048^2
-// on the H100). cuda-temporal queues k steps in one launch: an event then ends k steps, each
-// timed as 1/k of the interval (`launched` counts the steps queued on the device; `flush`
-// queues those still held back).
-class EventStepTimer final : public StepTimer {
- public:
-  EventStepTimer(cudaStream_t s, const std::int64_t* launched, std::function<void()> flush)
-      : s_(s), launched_(launched), flush_(std::move(flush)) {}
-  ~EventStepTimer() override {
-    for (cudaEvent_t e : events_) cudaEventDestroy(e);
-  }
-  void begin() override {
-    if (marks_ == 0) mark();
-  }
-  void end() override {
-    if (*launched_ == last_) return;
-    mark();
-    if (marks_ > 4096) resolve();
-  }
-  std::vector<double> take() override {
-    flush_();
-    end();
-    resolve();
-    marks_ = 0;
-    return std::exchange(done_, {});
-  }
-  std::string clock() const override { return "CUDA events"; }
-
- private:
-  void mark() {
-    if (marks_ == events_.size()) {
-      cudaEvent_t e = nullptr;
-      check(cudaEventCreate(&e), "creating a timing event");
-      events_.push_back(e);
-      steps_.push_back(0);
-    }
-    steps_[marks_] = int(*launched_ - last_);
-    last_ = *launched_;
-    check(cudaEventRecord(events_[marks_++], s_), "recording a step's end");
-  }
-  // The steps marked so far into done_; the last mark stays as the next step's start.
-  void resolve() {
-    if (marks_ == 0) return;
-    check(cudaEventSynchronize(events_[marks_ - 1]), "waiting for the timed steps");
-    for (std::size_t k = 1; k < marks_; ++k) {
-      float ms = 0.f;
-      check(cudaEventElapsedTime(&ms, events_[k - 1], events_[k]), "reading the step timer");
-      done_.insert(done_.end(), steps_[k], double(ms) / steps_[k]);
-    }
-    std::swap(events_[0], events_[marks_ - 1]);
-    marks_ = 1;
-  }
-  cudaStream_t s_;
-  const std::int64_t* launched_;
-  std::int64_t last_ = 0;  // *launched_ at the last mark
-  std::function<void()> flush_;
-  std::vector<cudaEvent_t> events_;
-  std::vector<int> steps_;  // steps ended by each event
-  std::size_t marks_ = 0;  // events recorded since the last resolve
-  std::vector<double> done_;
 };
 
 class Impl final : public CudaPipeline, private ForceKernels, private ForceStage, private UpdateStage {

@@ -70,4 +70,50 @@ void EventSpans::collect(Profiler* p) {
   pending_.clear();
 }
 
+EventStepTimer::~EventStepTimer() {
+  for (cudaEvent_t e : events_) cudaEventDestroy(e);
+}
+
+void EventStepTimer::begin() {
+  if (marks_ == 0) mark();
+}
+
+void EventStepTimer::end() {
+  if (*launched_ == last_) return;
+  mark();
+  if (marks_ > 4096) resolve();
+}
+
+std::vector<double> EventStepTimer::take() {
+  flush_();
+  end();
+  resolve();
+  marks_ = 0;
+  return std::exchange(done_, {});
+}
+
+void EventStepTimer::mark() {
+  if (marks_ == events_.size()) {
+    cudaEvent_t e = nullptr;
+    check(cudaEventCreate(&e), "creating a timing event");
+    events_.push_back(e);
+    steps_.push_back(0);
+  }
+  steps_[marks_] = int(*launched_ - last_);
+  last_ = *launched_;
+  check(cudaEventRecord(events_[marks_++], s_), "recording a step's end");
+}
+
+void EventStepTimer::resolve() {
+  if (marks_ == 0) return;
+  check(cudaEventSynchronize(events_[marks_ - 1]), "waiting for the timed steps");
+  for (std::size_t k = 1; k < marks_; ++k) {
+    float ms = 0.f;
+    check(cudaEventElapsedTime(&ms, events_[k - 1], events_[k]), "reading the step timer");
+    done_.insert(done_.end(), steps_[k], double(ms) / steps_[k]);
+  }
+  std::swap(events_[0], events_[marks_ - 1]);
+  marks_ = 1;
+}
+
 }  // namespace deformlab::cuda
