@@ -209,7 +209,7 @@ int run_command(const RunArgs& a) {
     if (in.entry->name == "cuda-temporal" && in.model.volume())
       std::cerr << "deformlab: note: on lattices cuda-temporal took longer a step than cuda-fused at every "
                 << "steps_per_launch and tile measured (H100, 256^3: a node's 32 springs bind the step to arithmetic, "
-                << "which the halo only adds to; README, cuda-temporal); cuda-fused is the faster choice there\n";
+                << "which the halo only adds to; docs/speed.md); cuda-fused is the faster choice there\n";
     Profiler profiler;
     profiler.stream_csv(dir.staged("spans.csv").string(), a.trace);  // the trace needs them all
     const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);
