@@ -13,6 +13,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 #include <stdexcept>
@@ -84,6 +85,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
     if (o_.variant == Variant::temporal) plan_temporal();
+    if (fused_ && m.grid()) plan_prefetch();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
@@ -409,10 +411,16 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // The result of a one-force-pass schedule: the update kernel after a force pass, or with
   // `fused` forces, update and constraints in one kernel.
   void one_pass(bool fused) {
+    with_rule([&](auto rule) { one_pass_as<rule()>(fused); });
+  }
+  // Calls f(Rule) with the one-pass update rule (RULE_*) of the schedule as a compile-time flag.
+  template <class F>
+  void with_rule(F&& f) const {
+    using std::integral_constant;
     switch (sched_.rule) {
-      case UpdateRule::runge_kutta: return one_pass_as<RULE_RUNGE_KUTTA>(fused);
-      case UpdateRule::semi_implicit_euler: return one_pass_as<RULE_SEMI_IMPLICIT_EULER>(fused);
-      case UpdateRule::verlet: return one_pass_as<RULE_VERLET>(fused);
+      case UpdateRule::runge_kutta: return f(integral_constant<int, RULE_RUNGE_KUTTA>{});
+      case UpdateRule::semi_implicit_euler: return f(integral_constant<int, RULE_SEMI_IMPLICIT_EULER>{});
+      case UpdateRule::verlet: return f(integral_constant<int, RULE_VERLET>{});
       case UpdateRule::backward_euler: throw std::logic_error("one-pass update for backward Euler");
     }
   }
@@ -436,10 +444,27 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
             <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg,
-                                                            stop_check());
+                                                            stop_check(), prefetch_);
       });
       check_launch("launching the fused step kernel");
     }
+  }
+
+  // How many nodes ahead a fused grid launch asks L2 for (dev::fused_grid): a third of the
+  // nodes the device runs at once.
+  void plan_prefetch() {
+    with_rule([&](auto rule) {
+      with_grid_flags([&](auto n, auto damped) {
+        const dim3 t = grid_threads();
+        int per_sm = 0, device = 0, sms = 0;
+        check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, dev::fused_grid<n(), damped(), rule()>,
+                                                            int(t.x * t.y), 0),
+              "querying the fused kernel's occupancy");
+        check(cudaGetDevice(&device), "querying the device");
+        check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "querying the SM count");
+        prefetch_ = int(std::int64_t(per_sm) * sms * t.x * t.y / 3);
+      });
+    });
   }
 
   // Verlet's previous positions of state c: the other ping-pong buffer, or (cuda-temporal,
@@ -593,6 +618,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
   cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
   int cur_ = 0;
+  int prefetch_ = 0;  // fused grid launches: plan_prefetch
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back
