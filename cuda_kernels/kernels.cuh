@@ -226,8 +226,9 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
 // Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v) and
 // x_prev (Verlet), writes (xo, vo). x_prev may alias xo.
 // Each thread first asks L2 for the state of the node `prefetch` after its own, which a block
-// launched later reads: its loads then wait on L2 rather than on DRAM. (H100, paper scene,
-// fast math, a third of the resident nodes ahead: 5% faster at 2048^2, Verlet 7% at 8192^2.)
+// launched later reads: its loads then wait on L2 rather than on DRAM (H100, paper scene, fast
+// math: semi-implicit Euler 4% and Verlet 5% faster at 2048^2, Verlet 6% at 8192^2; explicit
+// Euler and exact math within 1.5% either way; docs/speed.md).
 template <int N, bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil st, float weight,
                                                          const float4* __restrict__ x, const float4* __restrict__ v,
