@@ -85,7 +85,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
     if (o_.variant == Variant::temporal) plan_temporal();
-    if (fused_ && m.grid()) plan_prefetch();
+    if (dev::kPrefetchAhead && fused_ && m.grid()) plan_prefetch();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
@@ -450,8 +450,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
   }
 
-  // How many nodes ahead a fused grid launch asks L2 for (dev::fused_grid): a third of the
-  // nodes the device runs at once.
+  // How many nodes ahead a fused grid launch asks L2 for (dev::fused_grid, fast math): a third
+  // of the nodes the device runs at once.
   void plan_prefetch() {
     with_rule([&](auto rule) {
       with_grid_flags([&](auto n, auto damped) {
@@ -618,7 +618,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
   cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
   int cur_ = 0;
-  int prefetch_ = 0;  // fused grid launches: plan_prefetch
+  int prefetch_ = 0;  // fused grid launches with dev::kPrefetchAhead: plan_prefetch
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back

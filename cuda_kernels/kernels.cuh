@@ -177,6 +177,15 @@ constexpr int kGatherRegisters = 40;
 constexpr int kGatherRegisters = 48;
 #endif
 
+// Whether fused_grid asks L2 for the state of a node ahead of its own: in fast math only. With
+// exact math the kernel is bound by its arithmetic, and the prefetch measured 1-2% slower there
+// except for Verlet (H100, 2048^2 and 8192^2 cloths, a 256^3 lattice; docs/speed.md).
+#ifdef DL_CUDA_FAST_MATH
+constexpr bool kPrefetchAhead = true;
+#else
+constexpr bool kPrefetchAhead = false;
+#endif
+
 // Halo of the shared tile: flexion springs reach two nodes.
 constexpr int kHalo = 2;
 
@@ -225,10 +234,10 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
 
 // Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v) and
 // x_prev (Verlet), writes (xo, vo). x_prev may alias xo.
-// Each thread first asks L2 for the state of the node `prefetch` after its own, which a block
-// launched later reads: its loads then wait on L2 rather than on DRAM (H100, paper scene, fast
-// math: semi-implicit Euler 4% and Verlet 5% faster at 2048^2, Verlet 6% at 8192^2; explicit
-// Euler and exact math within 1.5% either way; docs/speed.md).
+// With kPrefetchAhead each thread first asks L2 for the state of the node `prefetch` after its
+// own, which a block launched later reads: its loads then wait on L2 rather than on DRAM (H100,
+// paper scene: semi-implicit Euler 4% and Verlet 5% faster at 2048^2, Verlet 6% at 8192^2,
+// explicit Euler within 1%; docs/speed.md).
 template <int N, bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil st, float weight,
                                                          const float4* __restrict__ x, const float4* __restrict__ v,
@@ -239,7 +248,7 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil s
   float d = 0.f;
   if (i < s.nx && j < s.ny) {
     const int node = P::grid_node(i, j, k, s.nx, s.ny);
-    if (node < s.node_count - prefetch) {
+    if (kPrefetchAhead && node < s.node_count - prefetch) {
       asm volatile("prefetch.global.L2 [%0];" ::"l"(x + node + prefetch));
       asm volatile("prefetch.global.L2 [%0];" ::"l"(v + node + prefetch));
     }
