@@ -413,7 +413,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   void one_pass(bool fused) {
     with_rule([&](auto rule) { one_pass_as<rule()>(fused); });
   }
-  // Calls f(Rule) with the one-pass update rule (RULE_*) of the schedule as a compile-time flag.
+  // Calls f(Rule) with the one-pass update rule (RULE_*) of the schedule as a compile-time flag
+  // (the one-step and cuda-temporal launches, the prefetch plan).
   template <class F>
   void with_rule(F&& f) const {
     using std::integral_constant;
@@ -421,7 +422,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       case UpdateRule::runge_kutta: return f(integral_constant<int, RULE_RUNGE_KUTTA>{});
       case UpdateRule::semi_implicit_euler: return f(integral_constant<int, RULE_SEMI_IMPLICIT_EULER>{});
       case UpdateRule::verlet: return f(integral_constant<int, RULE_VERLET>{});
-      case UpdateRule::backward_euler: throw std::logic_error("one-pass update for backward Euler");
+      case UpdateRule::backward_euler: throw std::logic_error("a one-pass launch for backward Euler");
     }
   }
   template <int Rule>
@@ -456,13 +457,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     with_rule([&](auto rule) {
       with_grid_flags([&](auto n, auto damped) {
         const dim3 t = grid_threads();
-        int per_sm = 0, device = 0, sms = 0;
+        int per_sm = 0;
         check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, dev::fused_grid<n(), damped(), rule()>,
                                                             int(t.x * t.y), 0),
               "querying the fused kernel's occupancy");
-        check(cudaGetDevice(&device), "querying the device");
-        check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "querying the SM count");
-        prefetch_ = int(std::int64_t(per_sm) * sms * t.x * t.y / 3);
+        prefetch_ = int(std::int64_t(per_sm) * device_info().sm_count * t.x * t.y / 3);
       });
     });
   }
@@ -533,14 +532,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // Launches the held steps, if any (before anything reads the state or its step times).
   void flush() {
     if (pending_ == 0) return;
-    timed(span::force_update, [&] {
-      switch (sched_.rule) {
-        case UpdateRule::runge_kutta: return launch_temporal<RULE_RUNGE_KUTTA>();
-        case UpdateRule::semi_implicit_euler: return launch_temporal<RULE_SEMI_IMPLICIT_EULER>();
-        case UpdateRule::verlet: return launch_temporal<RULE_VERLET>();
-        case UpdateRule::backward_euler: throw std::logic_error("cuda-temporal step for backward Euler");
-      }
-    }, pending_);
+    timed(span::force_update, [&] { with_rule([&](auto rule) { launch_temporal<rule()>(); }); }, pending_);
     end_launch(pending_, held_t_[0]);
     pending_ = 0;
   }
