@@ -104,6 +104,11 @@ DeviceInfo device_info();
 // Median GPU time of a device-to-device cudaMemcpy of `bytes`, ms (CUDA events, `reps` copies
 // after one warm-up).
 double copy_ms(std::int64_t bytes, int reps);
+// The gather floor: cuda-fused's loads and stores on an n x n cloth without its arithmetic
+// (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs); the
+// previous positions with `previous` (Verlet)), on blocks of `tile`. Median over `batches`
+// batches of 10 launches after 10 warm-up launches, ms per launch (CUDA events).
+double gather_floor_ms(int n, Tile tile, bool velocities, bool previous, int batches);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.
 double floor_bytes_per_node(const Model& m, Integrator i, const Options& o);
