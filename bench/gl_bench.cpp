@@ -1,9 +1,12 @@
 // `deformlab-bench gl`: glsl-tf and glsl-compute ms per step on cloth grids, beside a
-// pass-through transform feedback that only copies the two state attributes: the ceiling
-// of the transform-feedback route on this GPU.
+// pass-through transform feedback that only copies the two state attributes (the ceiling of
+// the transform-feedback route on this GPU) and glsl-compute's gather floor (its loads and
+// stores without its arithmetic).
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "bench.hpp"
 #include "core/state.hpp"
@@ -76,6 +79,39 @@ Stats time_passthrough(int n, const StepOptions& o) {
   return s;
 }
 
+// glsl-compute's gather floor (shaders/gather_floor.comp) on an n x n cloth: step.comp's loads
+// and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong.
+Stats time_gather_floor(int n, bool verlet, const StepOptions& o) {
+  using namespace gl;
+  const std::string defines = "#define TILE_X " + std::to_string(kComputeTileX) + "\n#define TILE_Y " +
+                              std::to_string(kComputeTileY) + "\n" + stencil_defines(false) +
+                              (verlet ? "#define PREVIOUS 1\n" : "");
+  Program prog = make_program({{GL_COMPUTE_SHADER, "gather_floor.comp"}}, defines);
+  const std::vector<float> rest(std::size_t(n) * n * 4, 0.5f);
+  Buffer buf[2][3];
+  for (auto& state : buf)
+    for (Buffer& b : state) b = make_buffer(rest.size() * sizeof(float), rest.data());
+  Timer timer;
+  glUseProgram(prog.id());
+  glUniform1i(0, n);
+  for (int k = 0; k < o.warmup + o.reps; ++k) {
+    if (k == o.warmup) timer.take();
+    const int c = k % 2;
+    for (GLuint a = 0; a < 3; ++a) {
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, a, buf[c][a].id());
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a].id());
+    }
+    timer.begin();
+    glDispatchCompute(GLuint((n + kComputeTileX - 1) / kComputeTileX), GLuint((n + kComputeTileY - 1) / kComputeTileY), 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    timer.end();
+  }
+  glUseProgram(0);
+  const Stats s = stats(timer.take());
+  check("the gather floor");
+  return s;
+}
+
 void run_gl(const StepOptions& o) {
   const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
@@ -86,16 +122,19 @@ void run_gl(const StepOptions& o) {
             << "method: " << gl::Timer().method() << " around each step, " << o.warmup
             << " warm-up steps, median of " << o.reps << " timed steps\n"
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
-               "the ceiling of the transform-feedback route\n\n"
+               "the ceiling of the transform-feedback route\n"
+            << "gather floor: glsl-compute's loads and stores (its work groups and stencil) without its arithmetic; "
+               "glsl-compute in exact and fast math\n\n"
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
-            << std::setw(14) << "tf/ceiling" << std::setw(14) << "glsl-compute" << std::setw(16) << "tf Mnodes/s"
-            << std::setw(18) << "compute Mnodes/s" << "\n";
+            << std::setw(14) << "tf/ceiling" << std::setw(14) << "gather floor" << std::setw(15) << "compute exact"
+            << std::setw(14) << "compute fast" << std::setw(12) << "fast/floor" << "\n";
   std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
-    Stats ceiling = time_passthrough(m.node_count(), o), tf, compute;
+    const Stats ceiling = time_passthrough(m.node_count(), o), floor = time_gather_floor(n, integ == Integrator::verlet, o);
+    Stats tf, compute, compute_fast;
     std::string neighbours;
     {
       auto pipe = gl::make_tf_pipeline(setup);
@@ -106,14 +145,21 @@ void run_gl(const StepOptions& o) {
       auto pipe = gl::make_compute_pipeline(setup);
       compute = time_pipeline(*pipe, m, o);
     }
-    auto rate = [&](const Stats& s) { return m.node_count() / (s.median * 1e3); };
+    {
+      PipelineSetup fast = setup;
+      fast.options["math"] = "fast";
+      auto pipe = gl::make_compute_pipeline(fast);
+      compute_fast = time_pipeline(*pipe, m, o);
+    }
     std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(16)
-              << ceiling.median << std::setw(12) << tf.median << std::setw(14) << std::setprecision(3)
-              << tf.median / ceiling.median << std::setw(14) << compute.median << std::setw(16)
-              << std::setprecision(1) << rate(tf) << std::setw(18) << rate(compute)
+              << ceiling.median << std::setw(12) << tf.median << std::setw(14) << tf.median / ceiling.median
+              << std::setw(14) << floor.median << std::setw(15) << compute.median << std::setw(14)
+              << compute_fast.median << std::setw(12) << compute_fast.median / floor.median
               << (neighbours == "grid arithmetic" ? "" : "  (" + neighbours + ")") << "\n";
     if (csv) {
-      const std::pair<const char*, Stats> rows[] = {{"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"glsl-compute", compute}};
+      const std::pair<const char*, Stats> rows[] = {
+          {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-gather-floor", floor}, {"glsl-compute", compute},
+          {"glsl-compute-fast", compute_fast}};
       for (const auto& [what, s] : rows)
         csv << '"' << ctx.renderer << "\"," << n << "x" << n << "," << m.node_count() << "," << what << ","
             << s.median << "," << s.min << "," << s.p90 << "\n";

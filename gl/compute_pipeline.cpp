@@ -39,11 +39,11 @@ class ComputePipeline final : public GlPipeline {
 
  private:
   Program make_program(int, const std::string& defines) override {
-    const std::string tile = "#define TILE_X " + std::to_string(kTileX) + "\n#define TILE_Y " + std::to_string(kTileY) + "\n";
+    const std::string tile = "#define TILE_X " + std::to_string(kComputeTileX) + "\n#define TILE_Y " + std::to_string(kComputeTileY) + "\n";
     return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines + tile);
   }
 
-  // A window's work groups (step.comp): on grids tiles of kTileX x kTileY nodes over the rows
+  // A window's work groups (step.comp): on grids tiles of kComputeTileX x kComputeTileY nodes over the rows
   // the window touches, tile rows along y then z; else 256 nodes a group along x then y.
   struct WorkGroups {
     std::array<std::uint32_t, 3> groups;
@@ -55,8 +55,8 @@ class ComputePipeline final : public GlPipeline {
       return {{xy[0], xy[1], 1}, 0};
     }
     const int first_row = w.first / model().nx, rows = (w.first + w.count - 1) / model().nx - first_row + 1;
-    const auto yz = dispatch_shape((rows + kTileY - 1) / kTileY, max_groups_[1]);
-    return {{std::uint32_t((model().nx + kTileX - 1) / kTileX), yz[0], yz[1]}, first_row};
+    const auto yz = dispatch_shape((rows + kComputeTileY - 1) / kComputeTileY, max_groups_[1]);
+    return {{std::uint32_t((model().nx + kComputeTileX - 1) / kComputeTileX), yz[0], yz[1]}, first_row};
   }
 
   // Window by window (node_windows): the inputs bound over the nodes the window reads, the
@@ -96,9 +96,6 @@ class ComputePipeline final : public GlPipeline {
 
   // Uniform locations in step.comp.
   static constexpr GLint kFirst = 0, kCount = 1, kReadFirst = 2, kFirstRow = 3, kResultWord = 4, kLaunch = 5;
-  // A tile is a warp wide (coalesced rows) and 8 rows tall: 256 invocations reading 12 rows'
-  // worth of cache lines instead of 5 per row of 256.
-  static constexpr int kTileX = 32, kTileY = 8;
   std::array<GLint, 3> max_groups_{};  // work groups along x, y, z
 };
 

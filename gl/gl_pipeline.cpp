@@ -1,4 +1,5 @@
 #include "gl_pipeline.hpp"
+#include "pipelines_internal.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -39,17 +40,6 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
-// The grid stencil for the shaders: its size and its offsets (core/grid_stencil.hpp's table).
-std::string stencil_defines(bool volume) {
-  const int n = grid_stencil_size(volume);
-  std::string offsets;
-  for (int e = 0; e < n; ++e) {
-    const GridOffset o = grid_offset(volume, e);
-    offsets += std::string(e ? ", " : "") + "ivec3(" + std::to_string(o.di) + ", " + std::to_string(o.dj) + ", " +
-               std::to_string(o.dk) + ")";
-  }
-  return "#define STENCIL_SIZE " + std::to_string(n) + "\n#define STENCIL_OFFSETS ivec3[](" + offsets + ")\n";
-}
 
 // A count option's value: a whole number of at least 1, else nothing.
 std::optional<std::int64_t> parse_count(const std::string& s) {
@@ -72,6 +62,17 @@ Math read_math(const std::string& name, const PipelineOptions& o) {
 }
 
 }  // namespace
+
+std::string stencil_defines(bool volume) {
+  const int n = grid_stencil_size(volume);
+  std::string offsets;
+  for (int e = 0; e < n; ++e) {
+    const GridOffset o = grid_offset(volume, e);
+    offsets += std::string(e ? ", " : "") + "ivec3(" + std::to_string(o.di) + ", " + std::to_string(o.dj) + ", " +
+               std::to_string(o.dk) + ")";
+  }
+  return "#define STENCIL_SIZE " + std::to_string(n) + "\n#define STENCIL_OFFSETS ivec3[](" + offsets + ")\n";
+}
 
 std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align) {
   if (n <= max_nodes) return {{0, int(n), 0, int(n)}};

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "core/pipeline.hpp"
 #include "gl_pipeline.hpp"
@@ -19,5 +20,14 @@ std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAl
 // The compute passes' dispatch: `groups` work groups as x by y, x at most `max_x` (a driver
 // may allow only the spec's 65535), y as small as possible, x * y - groups < y.
 std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t max_x);
+
+// glsl-compute's work group on grids (step.comp's TILE_X x TILE_Y): a warp wide (coalesced
+// rows) and 8 rows tall, 256 invocations reading 12 rows' worth of cache lines instead of 5 per
+// row of 256.
+inline constexpr int kComputeTileX = 32, kComputeTileY = 8;
+
+// The grid stencil for the shaders: STENCIL_SIZE and STENCIL_OFFSETS as defines
+// (core/grid_stencil.hpp's table).
+std::string stencil_defines(bool volume);
 
 }  // namespace deformlab::gl
