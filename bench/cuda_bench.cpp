@@ -112,9 +112,9 @@ class Report {
     r.gbs = r.floor_bytes * double(r.nodes) / (r.ms * 1e-3) / 1e9;
     r.of_copy = r.gbs / copy_gbs_;
     if (csv_)
-      csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator << "," << r.tile
-           << "," << r.math << "," << steps_per_launch << "," << r.graphs << "," << r.ms << "," << r.floor_bytes << "," << r.gbs << ","
-           << r.of_copy << "\n";
+      csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator
+           << "," << r.tile << "," << r.math << "," << steps_per_launch << "," << r.graphs << "," << r.ms << ","
+           << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
     return r;
   }
 
@@ -196,9 +196,9 @@ void run_cuda(const CudaOptions& o) {
 
   if (o.tile_size > 0) {
     std::cout << "\n[gather floor] cuda-fused's loads and stores at " << o.tile_size << "^2 without its arithmetic "
-              << "(block " << cuda::Tile{}.x << "x" << cuda::Tile{}.y << "): each node's x and v and its 12 neighbours' x, and their v where springs are damped "
-              << "(the paper scene), Verlet's previous x; median of " << o.batches << " batches of 10 launches after "
-              << "10 warm-up launches (CUDA events)\n"
+              << "(block " << cuda::Tile{}.x << "x" << cuda::Tile{}.y << "): each node's x and v and its 12 "
+              << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
+              << "median of " << o.batches << " batches of 10 launches after 10 warm-up launches (CUDA events)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
     std::map<std::pair<SceneKind, bool>, double> floor_ms;

@@ -83,9 +83,7 @@ Stats time_passthrough(int n, const StepOptions& o) {
 // and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong.
 Stats time_gather_floor(int n, bool verlet, const StepOptions& o) {
   using namespace gl;
-  const std::string defines = "#define TILE_X " + std::to_string(kComputeTileX) + "\n#define TILE_Y " +
-                              std::to_string(kComputeTileY) + "\n" + stencil_defines(false) +
-                              (verlet ? "#define PREVIOUS 1\n" : "");
+  const std::string defines = compute_tile_defines() + stencil_defines(false) + (verlet ? "#define PREVIOUS 1\n" : "");
   Program prog = make_program({{GL_COMPUTE_SHADER, "gather_floor.comp"}}, defines);
   const std::vector<float> rest(std::size_t(n) * n * 4, 0.5f);
   Buffer buf[2][3];
@@ -102,7 +100,8 @@ Stats time_gather_floor(int n, bool verlet, const StepOptions& o) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a].id());
     }
     timer.begin();
-    glDispatchCompute(GLuint((n + kComputeTileX - 1) / kComputeTileX), GLuint((n + kComputeTileY - 1) / kComputeTileY), 1);
+    glDispatchCompute(GLuint((n + kComputeTileX - 1) / kComputeTileX), GLuint((n + kComputeTileY - 1) / kComputeTileY),
+                      1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     timer.end();
   }
@@ -133,7 +132,8 @@ void run_gl(const StepOptions& o) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
-    const Stats ceiling = time_passthrough(m.node_count(), o), floor = time_gather_floor(n, integ == Integrator::verlet, o);
+    const Stats ceiling = time_passthrough(m.node_count(), o),
+                floor = time_gather_floor(n, integ == Integrator::verlet, o);
     Stats tf, compute, compute_fast;
     std::string neighbours;
     {

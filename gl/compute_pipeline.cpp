@@ -4,6 +4,10 @@
 
 namespace deformlab::gl {
 
+std::string compute_tile_defines() {
+  return "#define TILE_X " + std::to_string(kComputeTileX) + "\n#define TILE_Y " + std::to_string(kComputeTileY) + "\n";
+}
+
 std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t max_x) {
   const std::int64_t y = (groups + max_x - 1) / max_x, x = (groups + y - 1) / y;
   return {std::uint32_t(x), std::uint32_t(y)};
@@ -39,12 +43,12 @@ class ComputePipeline final : public GlPipeline {
 
  private:
   Program make_program(int, const std::string& defines) override {
-    const std::string tile = "#define TILE_X " + std::to_string(kComputeTileX) + "\n#define TILE_Y " + std::to_string(kComputeTileY) + "\n";
-    return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines + tile);
+    return gl::make_program({{GL_COMPUTE_SHADER, "step.comp"}}, defines + compute_tile_defines());
   }
 
-  // A window's work groups (step.comp): on grids tiles of kComputeTileX x kComputeTileY nodes over the rows
-  // the window touches, tile rows along y then z; else 256 nodes a group along x then y.
+  // A window's work groups (step.comp): on grids tiles of kComputeTileX x kComputeTileY nodes
+  // over the rows the window touches, tile rows along y then z; else 256 nodes a group along x
+  // then y.
   struct WorkGroups {
     std::array<std::uint32_t, 3> groups;
     int first_row;

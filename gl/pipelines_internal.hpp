@@ -21,10 +21,11 @@ std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAl
 // may allow only the spec's 65535), y as small as possible, x * y - groups < y.
 std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t max_x);
 
-// glsl-compute's work group on grids (step.comp's TILE_X x TILE_Y): a warp wide (coalesced
-// rows) and 8 rows tall, 256 invocations reading 12 rows' worth of cache lines instead of 5 per
-// row of 256.
+// glsl-compute's work group on grids: a warp wide (coalesced rows) and 8 rows tall, 256
+// invocations reading 12 rows' worth of cache lines instead of 5 per row of 256; and the
+// defines that give it to a shader (TILE_X, TILE_Y).
 inline constexpr int kComputeTileX = 32, kComputeTileY = 8;
+std::string compute_tile_defines();
 
 // The grid stencil for the shaders: STENCIL_SIZE and STENCIL_OFFSETS as defines
 // (core/grid_stencil.hpp's table).
