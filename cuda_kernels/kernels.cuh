@@ -57,12 +57,21 @@ struct Window {
 // Undamped springs do not read the neighbours' velocities (kd = 0 makes the damping term 0
 // either way). The neighbours are loaded a group at a time before their springs are
 // computed, so that the loads are in flight together.
+// Damped neighbours loaded at a time (each brings x and v; undamped ones go four at a time).
+// Fast math: one, which keeps the kernels within their 40-register cap without spilling (two
+// spilled 40-52 bytes a thread) and took cuda-fused from 0.111-0.116 to 0.108 ms at 2048^2 and
+// from 1.68-1.71 to 1.63 at 8192^2 (H100, paper scene, Euler; docs/speed.md). Exact math: two
+// (one measured 4-5% slower).
+#ifdef DL_CUDA_FAST_MATH
+constexpr int kDampedGroup = 1;
+#else
+constexpr int kDampedGroup = 2;
+#endif
+
 template <int N, bool Damped, bool Checked>
 __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stencil& st, int i, int j, int k,
                                                 const Vec3f& xi, const Vec3f& vi, const Window& w) {
-  // Two damped or four undamped neighbours at a time: more in flight spill registers under
-  // kGatherRegisters (four damped: 13% slower in fast math on the H100 at 2048^2).
-  constexpr int G = Damped ? 2 : 4;
+  constexpr int G = Damped ? kDampedGroup : 4;
   Vec3f f{};
 #pragma unroll
   for (int g = 0; g < N; g += G) {
@@ -169,8 +178,8 @@ __device__ __forceinline__ void store_displacement(const StopCheck& c, float d) 
 // Register cap of the grid gather kernels: the compiler's choice (about 80) limits an SM to
 // 3 blocks of 256 threads; the gather is issue-bound, and more resident warps hide its
 // latencies better. Measured on the H100 (paper scene, 2048^2, fused): exact 48 (40: 11%
-// slower, 64 and 80 slower too); fast 40 (which spills 12-32 bytes a thread; 48 spills 28 and is
-// 11% slower, 36 8% slower).
+// slower, 64 and 80 slower too); fast 40 (48 11% slower, 36 8%; with the L2 prefetch and two
+// damped neighbours at a time, 44 4% and 48 12% slower).
 #ifdef DL_CUDA_FAST_MATH
 constexpr int kGatherRegisters = 40;
 #else
