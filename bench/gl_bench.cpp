@@ -1,6 +1,6 @@
 // `deformlab-bench gl`: glsl-tf and glsl-compute ms per step on cloth grids, beside a
 // pass-through transform feedback that only copies the two state attributes (the ceiling of
-// the transform-feedback route on this GPU) and glsl-compute's gather floor (its loads and
+// the transform-feedback route on this GPU) and glsl-compute's bare gather (its loads and
 // stores without its arithmetic).
 #include <iomanip>
 #include <iostream>
@@ -79,12 +79,12 @@ Stats time_passthrough(int n, const StepOptions& o) {
   return s;
 }
 
-// glsl-compute's gather floor (shaders/gather_floor.comp) on an n x n cloth: step.comp's loads
+// glsl-compute's bare gather (shaders/bare_gather.comp) on an n x n cloth: step.comp's loads
 // and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong.
-Stats time_gather_floor(int n, bool verlet, const StepOptions& o) {
+Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   using namespace gl;
   const std::string defines = compute_tile_defines() + stencil_defines(false) + (verlet ? "#define PREVIOUS 1\n" : "");
-  Program prog = make_program({{GL_COMPUTE_SHADER, "gather_floor.comp"}}, defines);
+  Program prog = make_program({{GL_COMPUTE_SHADER, "bare_gather.comp"}}, defines);
   const std::vector<float> rest(std::size_t(n) * n * 4, 0.5f);
   Buffer buf[2][3];
   for (auto& state : buf)
@@ -107,7 +107,7 @@ Stats time_gather_floor(int n, bool verlet, const StepOptions& o) {
   }
   glUseProgram(0);
   const Stats s = stats(timer.take());
-  check("the gather floor");
+  check("the bare gather");
   return s;
 }
 
@@ -122,18 +122,18 @@ void run_gl(const StepOptions& o) {
             << " warm-up steps, median of " << o.reps << " timed steps\n"
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
                "the ceiling of the transform-feedback route\n"
-            << "gather floor: glsl-compute's loads and stores (its work groups and stencil) without its arithmetic; "
+            << "bare gather: glsl-compute's loads and stores (its work groups and stencil) without its arithmetic; "
                "glsl-compute in exact and fast math\n\n"
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
-            << std::setw(14) << "tf/ceiling" << std::setw(14) << "gather floor" << std::setw(15) << "compute exact"
-            << std::setw(14) << "compute fast" << std::setw(12) << "fast/floor" << "\n";
+            << std::setw(14) << "tf/ceiling" << std::setw(14) << "bare gather" << std::setw(15) << "compute exact"
+            << std::setw(14) << "compute fast" << std::setw(12) << "fast/bare" << "\n";
   std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
     const Stats ceiling = time_passthrough(m.node_count(), o),
-                floor = time_gather_floor(n, integ == Integrator::verlet, o);
+                bare = time_bare_gather(n, integ == Integrator::verlet, o);
     Stats tf, compute, compute_fast;
     std::string neighbours;
     {
@@ -153,12 +153,12 @@ void run_gl(const StepOptions& o) {
     }
     std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(16)
               << ceiling.median << std::setw(12) << tf.median << std::setw(14) << tf.median / ceiling.median
-              << std::setw(14) << floor.median << std::setw(15) << compute.median << std::setw(14)
-              << compute_fast.median << std::setw(12) << compute_fast.median / floor.median
+              << std::setw(14) << bare.median << std::setw(15) << compute.median << std::setw(14)
+              << compute_fast.median << std::setw(12) << compute_fast.median / bare.median
               << (neighbours == "grid arithmetic" ? "" : "  (" + neighbours + ")") << "\n";
     if (csv) {
       const std::pair<const char*, Stats> rows[] = {
-          {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-gather-floor", floor}, {"glsl-compute", compute},
+          {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-bare-gather", bare}, {"glsl-compute", compute},
           {"glsl-compute-fast", compute_fast}};
       for (const auto& [what, s] : rows)
         csv << '"' << ctx.renderer << "\"," << n << "x" << n << "," << m.node_count() << "," << what << ","

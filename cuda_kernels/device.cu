@@ -1,8 +1,10 @@
-// Device discovery, memory checks and the benchmarks' ceilings: the copy bandwidth and the
-// gather floor.
+// Device discovery, memory checks and the benchmarks' references: the copy bandwidth and the
+// bare gather.
 #include <algorithm>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "check.cuh"
@@ -84,9 +86,9 @@ namespace {
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
 // and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous,
 // over which x is written), and writes x and v with the neighbours' components summed in, so
-// that no load is dead. Neighbours outside the grid are skipped; loads go four at a time.
-template <bool Velocities, bool Previous>
-__global__ void gather_floor(int n, const float4* __restrict__ x, const float4* __restrict__ v, float4* xo,
+// that no load is dead. Neighbours outside the grid are skipped; loads go Group at a time.
+template <bool Velocities, bool Previous, int Group>
+__global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v, float4* xo,
                              float4* __restrict__ vo) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y;
   if (i >= n || j >= n) return;
@@ -95,10 +97,10 @@ __global__ void gather_floor(int n, const float4* __restrict__ x, const float4* 
   if (Previous) sx.w += xo[node].x;
   const bool inside = i >= 2 && i < n - 2 && j >= 2 && j < n - 2;
 #pragma unroll
-  for (int g = 0; g < kClothStencil; g += 4) {
-    float4 xn[4], vn[4];
+  for (int g = 0; g < kClothStencil; g += Group) {
+    float4 xn[Group], vn[Group];
 #pragma unroll
-    for (int q = 0; q < 4; ++q) {
+    for (int q = 0; q < Group; ++q) {
       const GridOffset o = grid_offset(false, g + q);
       const bool ok = inside || (i + o.di >= 0 && i + o.di < n && j + o.dj >= 0 && j + o.dj < n);
       const int at = node + o.di + o.dj * n;
@@ -106,7 +108,7 @@ __global__ void gather_floor(int n, const float4* __restrict__ x, const float4* 
       if (Velocities) vn[q] = ok ? v[at] : float4{};
     }
 #pragma unroll
-    for (int q = 0; q < 4; ++q) {
+    for (int q = 0; q < Group; ++q) {
       sx.x += xn[q].x, sx.y += xn[q].y, sx.z += xn[q].z;
       if (Velocities) sv.x += vn[q].x, sv.y += vn[q].y, sv.z += vn[q].z;
     }
@@ -117,41 +119,50 @@ __global__ void gather_floor(int n, const float4* __restrict__ x, const float4* 
 
 }  // namespace
 
-double gather_floor_ms(int n, Tile tile, bool velocities, bool previous, int batches) {
+double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches) {
   const std::int64_t nodes = std::int64_t(n) * n;
-  require_device_memory(4 * nodes * std::int64_t(sizeof(float4)), "the gather floor");
+  require_device_memory(4 * nodes * std::int64_t(sizeof(float4)), "the bare gather");
   Buffer<float4> x, v, xo, vo;
-  x.allocate(std::size_t(nodes), "allocating the gather floor's positions");
-  v.allocate(std::size_t(nodes), "allocating the gather floor's velocities");
-  xo.allocate(std::size_t(nodes), "allocating the gather floor's output positions");
-  vo.allocate(std::size_t(nodes), "allocating the gather floor's output velocities");
+  x.allocate(std::size_t(nodes), "allocating the bare gather's positions");
+  v.allocate(std::size_t(nodes), "allocating the bare gather's velocities");
+  xo.allocate(std::size_t(nodes), "allocating the bare gather's output positions");
+  vo.allocate(std::size_t(nodes), "allocating the bare gather's output velocities");
   for (const Buffer<float4>* b : {&x, &v, &xo, &vo})
-    check(cudaMemset(b->get(), 0x3c, b->size() * sizeof(float4)), "filling the gather floor's arrays");
+    check(cudaMemset(b->get(), 0x3c, b->size() * sizeof(float4)), "filling the bare gather's arrays");
   const dim3 threads(unsigned(tile.x), unsigned(tile.y)),
       blocks(unsigned((n + tile.x - 1) / tile.x), unsigned((n + tile.y - 1) / tile.y));
-  auto kernel = velocities ? (previous ? gather_floor<true, true> : gather_floor<true, false>)
-                           : (previous ? gather_floor<false, true> : gather_floor<false, false>);
-  constexpr int kWarmup = 10, kBatch = 10;
-  auto launch = [&] { kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get()); };
-  for (int w = 0; w < kWarmup; ++w) launch();
-  check_launch("launching the gather floor");
+  using Kernel = void (*)(int, const float4*, const float4*, float4*, float4*);
+  auto pick = [&](auto group) -> Kernel {
+    constexpr int g = decltype(group)::value;
+    return velocities ? (previous ? bare_gather<true, true, g> : bare_gather<true, false, g>)
+                      : (previous ? bare_gather<false, true, g> : bare_gather<false, false, g>);
+  };
   cudaEvent_t e0, e1;
   check(cudaEventCreate(&e0), "creating a timing event");
   check(cudaEventCreate(&e1), "creating a timing event");
-  std::vector<double> ms;
-  for (int b = 0; b < batches; ++b) {
-    check(cudaEventRecord(e0), "recording the gather floor's start");
-    for (int l = 0; l < kBatch; ++l) launch();
-    check(cudaEventRecord(e1), "recording the gather floor's end");
-    check(cudaEventSynchronize(e1), "running the gather floor");
-    float t = 0.f;
-    check(cudaEventElapsedTime(&t, e0, e1), "reading the gather floor's timer");
-    ms.push_back(double(t) / kBatch);
+  constexpr int kWarmup = 10, kBatch = 10;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
+                              pick(std::integral_constant<int, 4>{})}) {
+    auto launch = [&] { kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get()); };
+    for (int w = 0; w < kWarmup; ++w) launch();
+    check_launch("launching the bare gather");
+    std::vector<double> ms;
+    for (int b = 0; b < batches; ++b) {
+      check(cudaEventRecord(e0), "recording the bare gather's start");
+      for (int l = 0; l < kBatch; ++l) launch();
+      check(cudaEventRecord(e1), "recording the bare gather's end");
+      check(cudaEventSynchronize(e1), "running the bare gather");
+      float t = 0.f;
+      check(cudaEventElapsedTime(&t, e0, e1), "reading the bare gather's timer");
+      ms.push_back(double(t) / kBatch);
+    }
+    std::sort(ms.begin(), ms.end());
+    best = std::min(best, ms[ms.size() / 2]);
   }
   cudaEventDestroy(e0);
   cudaEventDestroy(e1);
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  return best;
 }
 
 }  // namespace deformlab::cuda

@@ -1,5 +1,5 @@
 #version 430 core
-// glsl-compute's gather floor: step.comp's loads and stores on an n x n cloth (its work groups,
+// glsl-compute's bare gather: step.comp's loads and stores on an n x n cloth (its work groups,
 // its stencil, the fast build's unrolled loops) without its arithmetic. Each invocation reads its
 // node's x and v and its neighbours' x and v (step.comp reads them for every spring), with
 // PREVIOUS also Verlet's previous position, and writes them back with the neighbours'
