@@ -88,9 +88,13 @@ class Report {
     return record(r, k);
   }
 
-  // The bare gather (cuda::bare_gather_ms) of the scene's springs (damped: the paper scene)
-  // for one-step integrators (64 B a node) or Verlet (80), on cuda-fused's default block.
-  Row bare_gather(SceneKind kind, int n, bool verlet, const CudaOptions& o) {
+  // The bare gather (cuda::bare_gather_ms) of the scene's springs (their neighbours' velocities
+  // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
+  // node) or Verlet (80), on cuda-fused's default block.
+  Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
+    const Model& m = scene.model;
+    const bool damped = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
+    const int n = m.nx;
     const cuda::Tile tile;
     Row r;
     r.table = "bare-gather";
@@ -102,7 +106,7 @@ class Report {
     r.math = "none";
     r.graphs = false;
     r.nodes = std::int64_t(n) * n;
-    r.ms = cuda::bare_gather_ms(n, tile, kind == SceneKind::paper, verlet, o.batches);
+    r.ms = cuda::bare_gather_ms(n, tile, damped, verlet, o.batches);
     r.floor_bytes = verlet ? 80 : 64;
     return record(r, 1);
   }
@@ -204,13 +208,15 @@ void run_cuda(const CudaOptions& o) {
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
     std::map<std::pair<SceneKind, bool>, double> bare_ms;
-    for (SceneKind k : {SceneKind::paper, SceneKind::idealised})
+    for (SceneKind k : {SceneKind::paper, SceneKind::idealised}) {
+      const BenchScene scene(o.tile_size, k);
       for (bool verlet : {false, true}) {
-        const Row r = rep.bare_gather(k, o.tile_size, verlet, o);
+        const Row r = rep.bare_gather(k, scene, verlet, o);
         bare_ms[{k, verlet}] = r.ms;
         std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4)
                   << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%\n";
       }
+    }
 
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
               << "ceiling, the bare gather and the paper author's CUDA Verlet cloth kernel (" << o.reference_ms

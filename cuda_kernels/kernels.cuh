@@ -52,11 +52,6 @@ struct Window {
   __device__ __forceinline__ int at(int di, int dj, int dk) const { return base + di + dj * stride_j + dk * stride_k; }
 };
 
-// Sum of spring forces on grid node (i, j, k) from its N stencil neighbours (N: 12 cloth, 32
-// lattice). Checked: some neighbours may lie outside the grid (nodes within 2 of a border).
-// Undamped springs do not read the neighbours' velocities (kd = 0 makes the damping term 0
-// either way). The neighbours are loaded a group at a time before their springs are
-// computed, so that the loads are in flight together.
 // Damped neighbours loaded at a time (each brings x and v; undamped ones go four at a time).
 // Fast math: one, which keeps the kernels within their 40-register cap without spilling (two
 // spilled 40-52 bytes a thread) and took cuda-fused from 0.111-0.116 to 0.108 ms at 2048^2 and
@@ -68,6 +63,11 @@ constexpr int kDampedGroup = 1;
 constexpr int kDampedGroup = 2;
 #endif
 
+// Sum of spring forces on grid node (i, j, k) from its N stencil neighbours (N: 12 cloth, 32
+// lattice). Checked: some neighbours may lie outside the grid (nodes within 2 of a border).
+// Undamped springs do not read the neighbours' velocities (kd = 0 makes the damping term 0
+// either way). The neighbours are loaded a group at a time before their springs are
+// computed, so that the loads are in flight together.
 template <int N, bool Damped, bool Checked>
 __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stencil& st, int i, int j, int k,
                                                 const Vec3f& xi, const Vec3f& vi, const Window& w) {

@@ -40,7 +40,6 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
-
 // A count option's value: a whole number of at least 1, else nothing.
 std::optional<std::int64_t> parse_count(const std::string& s) {
   try {
