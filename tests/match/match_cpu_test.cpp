@@ -51,20 +51,25 @@ const Shape kShapes[] = {
     {"volume8x6x5", 8, 6, 5, true, true, false, Shape::volume},
 };
 
-// Option values tried beyond the defaults, by option name (PipelineEntry::options), and the
-// shapes (kShapes) they are tried on.
+// Option values tried beyond the defaults, by option name (PipelineEntry::options), the
+// shapes (kShapes) they are tried on and the integrators (by default one and several force
+// passes).
 struct OptionValues {
   const char* option;
   std::vector<std::string> values;
   std::vector<int> shapes;
+  std::vector<Integrator> integrators = {Integrator::semi_implicit_euler, Integrator::rk4};
 };
+// The one-pass rules of the fused kernels (each its own update code) and a multi-pass one.
+const std::vector<Integrator> kOnePassAndRk4 = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
+                                                Integrator::verlet, Integrator::rk4};
 const OptionValues kOptionValues[] = {
     {"force", {"tiled", "scatter"}, {0, 3, 7, 8}},
     {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
     {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
     {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
-    {"steps_per_launch", {"1", "3"}, {1, 3, 6}},  // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
-    {"math", {"fast"}, {0, 6, 7}},    // exact is the default: every case above runs it
+    {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},  // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
+    {"math", {"fast"}, {0, 6, 7}, kOnePassAndRk4},  // exact is the default: every case above runs it
 };
 
 struct Case {
@@ -160,7 +165,7 @@ bool runs(const PipelineEntry& e, int s) {
 }
 
 // The registry's pipelines x the integrators each runs x the shapes, with default options;
-// each non-default option value on two integrators (one and several force passes) and its shapes.
+// each non-default option value on its integrators and shapes.
 std::vector<Case> cases() {
   std::vector<Case> out;
   for (const PipelineEntry& e : pipelines().all()) {
@@ -170,10 +175,10 @@ std::vector<Case> cases() {
       for (int s = 0; s < int(std::size(kShapes)); ++s)
         if (runs(e, s)) out.push_back({e.name, i.id, s});
     }
-    for (const auto& [option, values, shapes] : kOptionValues) {
+    for (const auto& [option, values, shapes, integs] : kOptionValues) {
       if (std::find(e.options.begin(), e.options.end(), option) == e.options.end()) continue;
       for (const std::string& v : values)
-        for (Integrator i : {Integrator::semi_implicit_euler, Integrator::rk4})
+        for (Integrator i : integs)
           for (int s : shapes)
             if (runs(e, s) && e.unsupported(i).empty()) out.push_back({e.name, i, s, {{option, v}}});
     }
