@@ -56,32 +56,30 @@ DeviceInfo device_info() {
   return d;
 }
 
-double copy_ms(std::int64_t bytes, int reps) {
-  require_device_memory(2 * bytes, "the copy benchmark");
-  Buffer<char> a, b;
-  a.allocate(std::size_t(bytes), "allocating the copy source");
-  b.allocate(std::size_t(bytes), "allocating the copy destination");
-  check(cudaMemset(a.get(), 1, std::size_t(bytes)), "filling the copy source");
-  cudaEvent_t e0, e1;
-  check(cudaEventCreate(&e0), "creating a timing event");
-  check(cudaEventCreate(&e1), "creating a timing event");
+namespace {
+
+// The median over `batches` batches of `per_batch` calls of `work`, each batch timed by a pair
+// of CUDA events on the default stream after `warmup` calls: ms per call. `what` names the work.
+template <class Work>
+double median_event_ms(int warmup, int batches, int per_batch, Work&& work, const std::string& what) {
+  for (int w = 0; w < warmup; ++w) work();
+  check_launch(("starting " + what).c_str());
+  cudaEvent_t e[2];
+  for (cudaEvent_t& ev : e) check(cudaEventCreate(&ev), "creating a timing event");
   std::vector<double> ms;
-  for (int r = 0; r <= reps; ++r) {
-    check(cudaEventRecord(e0), "recording the copy start");
-    check(cudaMemcpyAsync(b.get(), a.get(), std::size_t(bytes), cudaMemcpyDeviceToDevice), "copying device memory");
-    check(cudaEventRecord(e1), "recording the copy end");
-    check(cudaEventSynchronize(e1), "running the copy");
+  for (int b = 0; b < batches; ++b) {
+    check(cudaEventRecord(e[0]), "recording a timing event");
+    for (int l = 0; l < per_batch; ++l) work();
+    check(cudaEventRecord(e[1]), "recording a timing event");
+    check(cudaEventSynchronize(e[1]), ("running " + what).c_str());
     float t = 0.f;
-    check(cudaEventElapsedTime(&t, e0, e1), "reading the copy timer");
-    if (r > 0) ms.push_back(t);  // the first copy is a warm-up
+    check(cudaEventElapsedTime(&t, e[0], e[1]), "reading a timing event");
+    ms.push_back(double(t) / per_batch);
   }
-  cudaEventDestroy(e0);
-  cudaEventDestroy(e1);
+  for (cudaEvent_t ev : e) cudaEventDestroy(ev);
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];
 }
-
-namespace {
 
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
 // and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous,
@@ -119,6 +117,17 @@ __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* _
 
 }  // namespace
 
+double copy_ms(std::int64_t bytes, int reps) {
+  require_device_memory(2 * bytes, "the copy benchmark");
+  Buffer<char> a, b;
+  a.allocate(std::size_t(bytes), "allocating the copy source");
+  b.allocate(std::size_t(bytes), "allocating the copy destination");
+  check(cudaMemset(a.get(), 1, std::size_t(bytes)), "filling the copy source");
+  return median_event_ms(1, reps, 1, [&] {
+    check(cudaMemcpyAsync(b.get(), a.get(), std::size_t(bytes), cudaMemcpyDeviceToDevice), "copying device memory");
+  }, "the copy");
+}
+
 double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches) {
   const std::int64_t nodes = std::int64_t(n) * n;
   require_device_memory(4 * nodes * std::int64_t(sizeof(float4)), "the bare gather");
@@ -137,31 +146,12 @@ double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batc
     return velocities ? (previous ? bare_gather<true, true, g> : bare_gather<true, false, g>)
                       : (previous ? bare_gather<false, true, g> : bare_gather<false, false, g>);
   };
-  cudaEvent_t e0, e1;
-  check(cudaEventCreate(&e0), "creating a timing event");
-  check(cudaEventCreate(&e1), "creating a timing event");
-  constexpr int kWarmup = 10, kBatch = 10;
   double best = std::numeric_limits<double>::infinity();
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
-                              pick(std::integral_constant<int, 4>{})}) {
-    auto launch = [&] { kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get()); };
-    for (int w = 0; w < kWarmup; ++w) launch();
-    check_launch("launching the bare gather");
-    std::vector<double> ms;
-    for (int b = 0; b < batches; ++b) {
-      check(cudaEventRecord(e0), "recording the bare gather's start");
-      for (int l = 0; l < kBatch; ++l) launch();
-      check(cudaEventRecord(e1), "recording the bare gather's end");
-      check(cudaEventSynchronize(e1), "running the bare gather");
-      float t = 0.f;
-      check(cudaEventElapsedTime(&t, e0, e1), "reading the bare gather's timer");
-      ms.push_back(double(t) / kBatch);
-    }
-    std::sort(ms.begin(), ms.end());
-    best = std::min(best, ms[ms.size() / 2]);
-  }
-  cudaEventDestroy(e0);
-  cudaEventDestroy(e1);
+                              pick(std::integral_constant<int, 4>{})})
+    best = std::min(best, median_event_ms(10, batches, 10, [&] {
+      kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get());
+    }, "the bare gather"));
   return best;
 }
 
