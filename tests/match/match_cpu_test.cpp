@@ -68,7 +68,8 @@ const OptionValues kOptionValues[] = {
     {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
     {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
     {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
-    {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},  // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
+    // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
+    {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},
     {"math", {"fast"}, {0, 6, 7}, kOnePassAndRk4},  // exact is the default: every case above runs it
 };
 
