@@ -38,6 +38,12 @@ cuda::Variant parse_variant(const std::string& s) {
   throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused, temporal)");
 }
 
+// The default block of variant v in math m on the bench's cloths, "WxH".
+std::string tile_name(cuda::Variant v, Math m) {
+  const cuda::Tile t = cuda::default_tile(v, m, Topology::cloth_grid);
+  return std::to_string(t.x) + "x" + std::to_string(t.y);
+}
+
 double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
 
 // Median ms per step from the rest state: warm-up steps, then `batches` batches of steps
@@ -78,7 +84,8 @@ class Report {
     r.grid = std::to_string(m.nx) + "^2";
     r.variant = cuda::to_string(opt.variant);
     r.integrator = std::string(info(integ).name);
-    r.tile = std::to_string(opt.tile.x) + "x" + std::to_string(opt.tile.y);
+    const cuda::Tile tile = cuda::tile_for(opt, m);
+    r.tile = std::to_string(tile.x) + "x" + std::to_string(tile.y);
     r.math = to_string(opt.math);
     const int k = opt.variant == cuda::Variant::temporal ? cuda::steps_per_launch(opt) : 1;
     r.graphs = opt.graphs;
@@ -90,12 +97,12 @@ class Report {
 
   // The bare gather (cuda::bare_gather_ms) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
-  // node) or Verlet (80), on cuda-fused's default block.
+  // node) or Verlet (80), on cuda-fused's block in fast math.
   Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
     const Model& m = scene.model;
     const bool damped = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
     const int n = m.nx;
-    const cuda::Tile tile;
+    const cuda::Tile tile = cuda::default_tile(cuda::Variant::fused, Math::fast, m.topology);
     Row r;
     r.table = "bare-gather";
     r.scene = to_string(kind);
@@ -154,7 +161,8 @@ void run_cuda(const CudaOptions& o) {
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);
-  std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", tile 16x8, step graphs on\n"
+  std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", exact math, default tiles, step "
+               "graphs on\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
             << "B/node" << std::setw(10) << "GB/s" << std::setw(10) << "of copy" << "\n";
   for (int n : o.sizes) {
@@ -184,9 +192,10 @@ void run_cuda(const CudaOptions& o) {
 
   if (o.tile_size > 0 && !o.tiles.empty()) {
     std::cout << "\n[tiles] block shape sweep at " << o.tile_size << "^2 (" << to_string(kind) << " scene, " << o.integrator
-              << "): ms/step; tiled stages the block + 2-node halo in shared memory\n"
+              << "): ms/step, exact math and cuda-fused in fast math too; tiled stages the block + 2-node halo in "
+                 "shared memory\n"
               << std::setw(8) << "tile" << std::setw(12) << "tiled" << std::setw(12) << "naive" << std::setw(12)
-              << "fused" << "\n";
+              << "fused" << std::setw(12) << "fused fast" << "\n";
     const BenchScene scene(o.tile_size, kind);
     for (const auto& t : o.tiles) {
       const cuda::Tile tile = cuda::parse_tile(t);
@@ -194,13 +203,15 @@ void run_cuda(const CudaOptions& o) {
       for (cuda::Variant v : {cuda::Variant::tiled, cuda::Variant::naive, cuda::Variant::fused})
         std::cout << std::setw(12)
                   << fixed(rep.measure("tiles", kind, scene, integ, {v, tile, true}, o).ms, 4);
-      std::cout << "\n";
+      const cuda::Options fast{cuda::Variant::fused, tile, true, Math::fast};
+      std::cout << std::setw(12) << fixed(rep.measure("tiles", kind, scene, integ, fast, o).ms, 4) << "\n";
     }
   }
 
   if (o.tile_size > 0) {
     std::cout << "\n[bare gather] cuda-fused's loads and stores at " << o.tile_size << "^2 without its arithmetic "
-              << "(block " << cuda::Tile{}.x << "x" << cuda::Tile{}.y << "): each node's x and v and its 12 "
+              << "(block " << tile_name(cuda::Variant::fused, Math::fast) << ", cuda-fused's in fast math): "
+              << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each the median of " << o.batches
               << " batches of 10 launches after 10 warm-up launches (CUDA events); a reference, not a bound "
@@ -220,7 +231,9 @@ void run_cuda(const CudaOptions& o) {
 
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
               << "ceiling, the bare gather and the paper author's CUDA Verlet cloth kernel (" << o.reference_ms
-              << " ms per step at 2048^2 on this machine type)\n"
+              << " ms per step at 2048^2 on this machine type), on cuda-fused's default blocks ("
+              << tile_name(cuda::Variant::fused, Math::exact) << " exact, " << tile_name(cuda::Variant::fused, Math::fast)
+              << " fast)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(12)
               << "ms/step" << std::setw(10) << "B/node" << std::setw(10) << "of copy" << std::setw(10) << "of bare"
               << std::setw(14) << "vs reference" << "\n";

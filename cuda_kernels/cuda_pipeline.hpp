@@ -26,12 +26,13 @@ const char* to_string(Variant v);
 
 // Thread-block shape over a grid's (i, j) plane for the gather kernels (one node per
 // thread); cuda-tiled stages the block's nodes plus a 2-node halo in shared memory.
+// 0 x 0: none chosen, the variant's default for the model and math (tile_for).
 struct Tile {
-  int x = 16, y = 8;
+  int x = 0, y = 0;
 };
 // "WxH" -> Tile; throws std::invalid_argument on anything else.
 Tile parse_tile(const std::string& s);
-// The tile named by the pipeline option "tile" ("WxH"), else the default.
+// The tile named by the pipeline option "tile" ("WxH"), else none (0 x 0).
 Tile tile_option(const PipelineOptions& o);
 
 // cuda-temporal's tile: the nodes each thread block writes (z: layers, on lattices). Zero: the
@@ -69,6 +70,13 @@ class CudaPipeline : public Pipeline {
 // The registry's options (tile, steps_per_launch, math) as variant v reads them; throws
 // std::invalid_argument on a bad value.
 Options options_of(Variant v, const PipelineOptions& o);
+// Variant v's tile in math m on a model of topology t when none is chosen: 16 x 8, and for
+// cuda-fused in fast math on cloths 32 x 8 (H100, paper scene, explicit Euler, one call: 0.1056
+// against 0.1076 ms at 2048^2 and 1.540 against 1.633 at 8192^2; exact math within 1% across
+// shapes; a 160^3 lattice 8% slower on 32 x 8 in fast math; docs/speed.md).
+Tile default_tile(Variant v, Math m, Topology t);
+// The tile the pipeline of options o runs model m on: o.tile, else default_tile.
+Tile tile_for(const Options& o, const Model& m);
 
 // cuda-temporal's steps per launch: the option, else 2 (on the H100 at 2048^2 and 8192^2 the
 // fastest on cloths; on lattices, whose halo grows in three axes, 4 fits no tile).

@@ -37,6 +37,14 @@ Tile tile_option(const PipelineOptions& o) {
   return it == o.end() ? Tile{} : parse_tile(it->second);
 }
 
+Tile default_tile(Variant v, Math m, Topology t) {
+  return v == Variant::fused && m == Math::fast && t == Topology::cloth_grid ? Tile{32, 8} : Tile{16, 8};
+}
+
+Tile tile_for(const Options& o, const Model& m) {
+  return o.tile.x > 0 ? o.tile : default_tile(o.variant, o.math, m.topology);
+}
+
 TemporalTile parse_temporal_tile(const std::string& s) {
   TemporalTile t;
   int* axes[] = {&t.x, &t.y, &t.z};
@@ -73,11 +81,14 @@ int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps
 }
 
 std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
-  return o.math == Math::fast ? fast::make_pipeline(s, o) : exact::make_pipeline(s, o);
+  Options with_tile = o;
+  with_tile.tile = tile_for(o, s.model);
+  return o.math == Math::fast ? fast::make_pipeline(s, with_tile) : exact::make_pipeline(s, with_tile);
 }
 
 std::unique_ptr<ForcePass> make_force_pass(const Model& m, const Params& p, Variant v, Tile tile, Math math) {
-  const Options o{v, tile, false, math};
+  Options o{v, tile, false, math};
+  o.tile = tile_for(o, m);
   return math == Math::fast ? fast::make_force_pass(m, p, o) : exact::make_force_pass(m, p, o);
 }
 

@@ -251,6 +251,21 @@ TEST(CudaPipeline, TileShapeAndMathArePipelineOptions) {
   EXPECT_THROW(cuda::tile_option({{"tile", "0x4"}}), std::invalid_argument);
 }
 
+TEST(CudaPipeline, FastFusedDefaultsToWiderBlocksOnCloths) {
+  using cuda::Variant;
+  const Model cloth = small_cloth(8, 8), lattice = small_lattice(4, 4, 4);
+  auto tile = [](Variant v, const PipelineOptions& o, const Model& m) {
+    const cuda::Tile t = cuda::tile_for(cuda::options_of(v, o), m);
+    return std::to_string(t.x) + "x" + std::to_string(t.y);
+  };
+  EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, cloth), "32x8");
+  EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, lattice), "16x8");
+  EXPECT_EQ(tile(Variant::fused, {}, cloth), "16x8");
+  EXPECT_EQ(tile(Variant::naive, {{"math", "fast"}}, cloth), "16x8");
+  EXPECT_EQ(tile(Variant::tiled, {{"math", "fast"}}, cloth), "16x8");
+  EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}, {"tile", "16x8"}}, cloth), "16x8");  // the option wins
+}
+
 TEST(CudaPipeline, ParsesTileShapes) {
   EXPECT_EQ(cuda::parse_tile("16x8").x, 16);
   EXPECT_EQ(cuda::parse_tile("16x8").y, 8);
