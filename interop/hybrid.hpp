@@ -17,7 +17,7 @@ struct HybridOptions {
   Update update = Update::transform_feedback;
   Mode mode = Mode::map;
   cuda::Variant force = cuda::Variant::naive;  // naive, tiled or scatter
-  cuda::Tile tile;                              // thread block of the grid force kernels
+  cuda::Tile tile;                              // thread block of the grid force kernels (0 x 0: default)
   Math math = Math::exact;                      // the CUDA force pass's and the GL update's arithmetic
 };
 
