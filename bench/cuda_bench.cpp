@@ -38,10 +38,9 @@ cuda::Variant parse_variant(const std::string& s) {
   throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused, temporal)");
 }
 
-// The default block of variant v in math m on the bench's cloths, "WxH".
-std::string tile_name(cuda::Variant v, Math m) {
-  const cuda::Tile t = cuda::default_tile(v, m, Topology::cloth_grid);
-  return std::to_string(t.x) + "x" + std::to_string(t.y);
+// cuda-fused's default block in math m on the bench's cloths, "WxH".
+std::string fused_block(Math m) {
+  return cuda::to_string(cuda::default_tile(cuda::Variant::fused, m, Topology::cloth_grid));
 }
 
 double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
@@ -84,8 +83,7 @@ class Report {
     r.grid = std::to_string(m.nx) + "^2";
     r.variant = cuda::to_string(opt.variant);
     r.integrator = std::string(info(integ).name);
-    const cuda::Tile tile = cuda::tile_for(opt, m);
-    r.tile = std::to_string(tile.x) + "x" + std::to_string(tile.y);
+    r.tile = cuda::to_string(cuda::tile_for(opt, m));
     r.math = to_string(opt.math);
     const int k = opt.variant == cuda::Variant::temporal ? cuda::steps_per_launch(opt) : 1;
     r.graphs = opt.graphs;
@@ -109,7 +107,7 @@ class Report {
     r.grid = std::to_string(n) + "^2";
     r.variant = "bare-gather";
     r.integrator = verlet ? "verlet" : "euler";
-    r.tile = std::to_string(tile.x) + "x" + std::to_string(tile.y);
+    r.tile = cuda::to_string(tile);
     r.math = "none";
     r.graphs = false;
     r.nodes = std::int64_t(n) * n;
@@ -210,7 +208,7 @@ void run_cuda(const CudaOptions& o) {
 
   if (o.tile_size > 0) {
     std::cout << "\n[bare gather] cuda-fused's loads and stores at " << o.tile_size << "^2 without its arithmetic "
-              << "(block " << tile_name(cuda::Variant::fused, Math::fast) << ", cuda-fused's in fast math): "
+              << "(block " << fused_block(Math::fast) << ", cuda-fused's in fast math): "
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each the median of " << o.batches
@@ -232,8 +230,7 @@ void run_cuda(const CudaOptions& o) {
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
               << "ceiling, the bare gather and the paper author's CUDA Verlet cloth kernel (" << o.reference_ms
               << " ms per step at 2048^2 on this machine type), on cuda-fused's default blocks ("
-              << tile_name(cuda::Variant::fused, Math::exact) << " exact, " << tile_name(cuda::Variant::fused, Math::fast)
-              << " fast)\n"
+              << fused_block(Math::exact) << " exact, " << fused_block(Math::fast) << " fast)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(12)
               << "ms/step" << std::setw(10) << "B/node" << std::setw(10) << "of copy" << std::setw(10) << "of bare"
               << std::setw(14) << "vs reference" << "\n";

@@ -32,6 +32,8 @@ struct Tile {
 };
 // "WxH" -> Tile; throws std::invalid_argument on anything else.
 Tile parse_tile(const std::string& s);
+// Tile -> "WxH".
+std::string to_string(Tile t);
 // The tile named by the pipeline option "tile" ("WxH"), else none (0 x 0).
 Tile tile_option(const PipelineOptions& o);
 

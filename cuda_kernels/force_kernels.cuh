@@ -31,7 +31,7 @@ inline unsigned blocks_for(std::int64_t n) { return unsigned((n + kBlock - 1) / 
 // launch limits with it.
 inline void check_tile(const Model& m, const Tile& t) {
   if (t.x < 1 || t.y < 1 || t.x * t.y > 1024)
-    throw std::invalid_argument("CUDA tile " + std::to_string(t.x) + "x" + std::to_string(t.y) +
+    throw std::invalid_argument("CUDA tile " + to_string(t) +
                                 " is not a valid block shape (1..1024 threads)");
   if (m.topology == Topology::general) return;
   if ((m.ny + t.y - 1) / t.y > 65535 || m.nz > 65535)

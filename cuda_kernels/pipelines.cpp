@@ -32,6 +32,8 @@ Tile parse_tile(const std::string& s) {
   }
 }
 
+std::string to_string(Tile t) { return std::to_string(t.x) + "x" + std::to_string(t.y); }
+
 Tile tile_option(const PipelineOptions& o) {
   const auto it = o.find("tile");
   return it == o.end() ? Tile{} : parse_tile(it->second);

@@ -255,8 +255,7 @@ TEST(CudaPipeline, FastFusedDefaultsToWiderBlocksOnCloths) {
   using cuda::Variant;
   const Model cloth = small_cloth(8, 8), lattice = small_lattice(4, 4, 4);
   auto tile = [](Variant v, const PipelineOptions& o, const Model& m) {
-    const cuda::Tile t = cuda::tile_for(cuda::options_of(v, o), m);
-    return std::to_string(t.x) + "x" + std::to_string(t.y);
+    return cuda::to_string(cuda::tile_for(cuda::options_of(v, o), m));
   };
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, cloth), "32x8");
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, lattice), "16x8");
