@@ -40,6 +40,7 @@ Tile tile_option(const PipelineOptions& o) {
 }
 
 Tile default_tile(Variant v, Math m, Topology t) {
+  if (v == Variant::fused && t == Topology::lattice) return {16, 16};
   return v == Variant::fused && m == Math::fast && t == Topology::cloth_grid ? Tile{32, 8} : Tile{16, 8};
 }
 

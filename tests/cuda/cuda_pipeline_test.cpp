@@ -251,15 +251,17 @@ TEST(CudaPipeline, TileShapeAndMathArePipelineOptions) {
   EXPECT_THROW(cuda::tile_option({{"tile", "0x4"}}), std::invalid_argument);
 }
 
-TEST(CudaPipeline, FastFusedDefaultsToWiderBlocksOnCloths) {
+TEST(CudaPipeline, FusedDefaultBlocksFollowMathAndTopology) {
   using cuda::Variant;
   const Model cloth = small_cloth(8, 8), lattice = small_lattice(4, 4, 4);
   auto tile = [](Variant v, const PipelineOptions& o, const Model& m) {
     return cuda::to_string(cuda::tile_for(cuda::options_of(v, o), m));
   };
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, cloth), "32x8");
-  EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, lattice), "16x8");
+  EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, lattice), "16x16");
+  EXPECT_EQ(tile(Variant::fused, {}, lattice), "16x16");
   EXPECT_EQ(tile(Variant::fused, {}, cloth), "16x8");
+  EXPECT_EQ(tile(Variant::naive, {}, lattice), "16x8");
   EXPECT_EQ(tile(Variant::naive, {{"math", "fast"}}, cloth), "16x8");
   EXPECT_EQ(tile(Variant::tiled, {{"math", "fast"}}, cloth), "16x8");
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}, {"tile", "16x8"}}, cloth), "16x8");  // the option wins
