@@ -80,8 +80,7 @@ int steps_per_launch_option(const PipelineOptions& o) {
   throw std::invalid_argument("option steps_per_launch '" + it->second + "' is not a count from 1 to 8");
 }
 
-int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps_per_launch : 2;
-}
+int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps_per_launch : 2; }
 
 std::unique_ptr<CudaPipeline> make_pipeline(const PipelineSetup& s, const Options& o) {
   Options with_tile = o;
