@@ -85,12 +85,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
     if (o_.variant == Variant::temporal) plan_temporal();
+    sets_ = !temporal_ && sched_.rule == UpdateRule::verlet ? 3 : 2;
     if (dev::kPrefetchAhead && fused_ && m.grid()) plan_prefetch();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
-    for (auto& b : x_) b.allocate(n_, "allocating positions");
-    for (auto& b : v_) b.allocate(n_, "allocating velocities");
+    for (int c = 0; c < sets_; ++c) {
+      x_[c].allocate(n_, "allocating positions");
+      v_[c].allocate(n_, "allocating velocities");
+    }
     for (int k = 0; k < sched_.stage_states; ++k) {
       sx_[k].allocate(n_, "allocating stage positions");
       sv_[k].allocate(n_, "allocating stage velocities");
@@ -99,8 +102,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
     if (temporal_ && sched_.rule == UpdateRule::verlet)
       for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
-    stop_.allocate(3, "allocating the stop rule's reduction");
-    check(cudaMemsetAsync(stop_.get(), 0, 3 * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
+    stop_.allocate(sets_ + 1, "allocating the stop rule's reduction");
+    check(cudaMemsetAsync(stop_.get(), 0, (sets_ + 1) * sizeof(unsigned), stream_),
+          "clearing the stop rule's reduction");
     void* h = nullptr;
     check(cudaHostAlloc(&h, sizeof(unsigned long long), cudaHostAllocMapped), "allocating the displacement read-back");
     disp_host_.reset(static_cast<unsigned long long*>(h));
@@ -123,7 +127,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     cur_ = 0;
     pending_ = 0;
     queued_ = Read::none;
-    check(cudaMemsetAsync(stop_.get(), 0, 2 * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
+    check(cudaMemsetAsync(stop_.get(), 0, sets_ * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
     upload_positions(x_[0], s.x);
     upload_vectors(v_[0], s.v);
     has_prev_ = !s.x_prev.empty();
@@ -182,19 +186,19 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     back_has_prev_ = has_prev_;
     back_ = Back::possible;
     if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
-    cur_ = 1 - cur_;
+    cur_ = after(cur_);
     launched_ += steps;
     ++result_launches_;
   }
 
-  // The kernels read state cur_ and write the other, so the state before the last launch stays
-  // until the next; but the one-step Verlet kernels overwrite the positions before it
-  // (cuda-temporal keeps them in prev_).
-  bool can_step_back() const override { return temporal_ || sched_.rule != UpdateRule::verlet; }
+  // The kernels read state cur_ and write the next set, so the state before the last launch
+  // stays until the next (one-step Verlet reads the positions before it from a third set;
+  // cuda-temporal keeps them in prev_).
+  bool can_step_back() const override { return true; }
   int steps_per_launch() const override { return temporal_ ? k_ : 1; }
   void step_back() override {
-    if (!can_step_back() || back_ != Back::possible) throw std::logic_error("cuda pipeline: no launch to take back");
-    cur_ = 1 - cur_;
+    if (back_ != Back::possible) throw std::logic_error("cuda pipeline: no launch to take back");
+    cur_ = before(cur_);
     t_ = back_t_;
     has_prev_ = back_has_prev_;
     back_ = Back::taken;
@@ -219,8 +223,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       bits = passed_on(read_after_ + 1);
     } else {
       unsigned* h = reinterpret_cast<unsigned*>(staging());
-      // No launch since: the last one read state 1 - cur_ and added into its word.
-      check(cudaMemcpyAsync(h, stop_.get() + 1 - cur_, sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
+      // No launch since: the last one read the set before cur_ and added into its word.
+      check(cudaMemcpyAsync(h, stop_.get() + before(cur_), sizeof(unsigned), cudaMemcpyDeviceToHost, stream_),
             "reading the largest displacement");
       check(cudaStreamSynchronize(stream_), "reading the largest displacement");
       bits = *h;
@@ -341,7 +345,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
   }
 
-  void capture(int parity) {
+  void capture(int set) {
     cudaGraph_t g = nullptr;
     check(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeThreadLocal), "starting the step capture");
     try {
@@ -352,7 +356,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       throw;
     }
     check(cudaStreamEndCapture(stream_, &g), "capturing the step graph");
-    const cudaError_t e = cudaGraphInstantiate(&graph_[parity], g, 0);
+    const cudaError_t e = cudaGraphInstantiate(&graph_[set], g, 0);
     cudaGraphDestroy(g);
     check(e, "instantiating the step graph");
   }
@@ -427,9 +431,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
   template <int Rule>
   void one_pass_as(bool fused) {
-    const int nxt = 1 - cur_;
+    const int nxt = after(cur_);
     const float w = float(sched_.weight());
-    const float4 *x = x_[cur_].get(), *v = v_[cur_].get(), *xp = x_[nxt].get();
+    const float4 *x = x_[cur_].get(), *v = v_[cur_].get(), *xp = prev_x(cur_).get();
     float4 *xo = x_[nxt].get(), *vo = v_[nxt].get();
     const Targets tg = targets();
     if (!fused) {
@@ -466,9 +470,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     });
   }
 
-  // Verlet's previous positions of state c: the other ping-pong buffer, or (cuda-temporal,
-  // whose launches read a tile's halo from it while others write) a pair of their own.
-  Buffer<float4>& prev_x(int c) { return temporal_ && sched_.rule == UpdateRule::verlet ? prev_[c] : x_[1 - c]; }
+  // The state sets after and before set c.
+  int after(int c) const { return (c + 1) % sets_; }
+  int before(int c) const { return (c + sets_ - 1) % sets_; }
+  // Verlet's previous positions of state c: the positions of the set before it, or
+  // (cuda-temporal, whose launches read a tile's halo from them while others write) a pair of
+  // their own.
+  Buffer<float4>& prev_x(int c) { return temporal_ && sched_.rule == UpdateRule::verlet ? prev_[c] : x_[before(c)]; }
 
   // cuda-temporal's checks and launch shape: grids only; the tile's region (the tile and a
   // halo of 2k nodes, two copies of x and v a cell) within the device's shared memory.
@@ -541,7 +549,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     dev::StepTargets tg{};
     for (int q = 0; q < pending_ && p_.drag.active(); ++q)
       tg.step[q] = {p_.drag.target(held_t_[q]), p_.drag.target(held_t_[q] + p_.dt)};
-    const int nxt = 1 - cur_;
+    const int nxt = after(cur_);
     const bool verlet = Rule == RULE_VERLET;
     const dim3 blocks = temporal_blocks(), threads(dev::kTemporalThreads);
     with_grid_flags([&](auto n, auto damped) {
@@ -560,9 +568,12 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     check_launch("launching the temporal step kernel");
   }
 
-  // The stop rule's reduction in the launch that writes the step's result: a launch from state
-  // c adds into word c (the step graphs hold one parity each).
-  dev::StopCheck stop_check() { return {stop_.get() + cur_, stop_.get() + 1 - cur_, stop_.get() + 2, disp_device_}; }
+  // The stop rule's reduction in the launch that writes the step's result: a launch from set c
+  // adds into word c and passes on the word of the launch before it (the step graphs hold one
+  // set each); the word after the sets' counts the launches.
+  dev::StopCheck stop_check() {
+    return {stop_.get() + cur_, stop_.get() + before(cur_), stop_.get() + sets_, disp_device_};
+  }
 
   // A stage state or the step's result from the slopes with a non-zero weight.
   void combine_pass(const Pass& pass) {
@@ -575,7 +586,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       ++terms.count;
     }
     const bool result = pass.dst == Pass::kResult;
-    const int nxt = 1 - cur_;
+    const int nxt = after(cur_);
     float4* xo = result ? x_[nxt].get() : sx_[pass.dst - 1].get();
     float4* vo = result ? v_[nxt].get() : sv_[pass.dst - 1].get();
     dev::combine<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, x_[cur_].get(), v_[cur_].get(), terms, xo, vo,
@@ -591,8 +602,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int n_ = 0;
   bool fused_ = false;
 
-  Buffer<float4> x_[2], v_[2];  // ping-pong: cur_ is the current state; the other holds the
-                                // previous step's (Verlet: x_prev) until the next step
+  // State sets in turn: cur_ is the current state, the set before it the previous step's
+  // until the next step. Three with the one-step Verlet kernels, which read the positions
+  // before the current ones, else two.
+  Buffer<float4> x_[3], v_[3];
+  int sets_ = 2;
   Buffer<float4> sx_[3], sv_[3], acc_[4];
   Buffer<float4> prev_[2];  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
   Buffer<unsigned> stop_;  // the maximum of a launch from each state, the result launches (stop_check)
@@ -608,7 +622,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
-  cudaGraphExec_t graph_[2] = {};  // one step from each ping-pong parity
+  cudaGraphExec_t graph_[3] = {};  // one step from each state set
   int cur_ = 0;
   int prefetch_ = 0;  // fused grid launches with dev::kPrefetchAhead: plan_prefetch
   bool has_prev_ = false, stepped_ = false;

@@ -119,8 +119,8 @@ __device__ __forceinline__ Vec3f gather_csr(const int* __restrict__ offset, cons
   return f;
 }
 
-// The one-pass update (rule RULE_*) and the constraints of node i, written to (xo, vo).
-// x_prev may alias xo (Verlet writes the new positions over the previous ones, node by node).
+// The one-pass update (rule RULE_*) and the constraints of node i, written to (xo, vo); x_prev:
+// Verlet's previous positions.
 // Returns the node's term of the stop rule (P::displacement).
 template <int Rule>
 __device__ __forceinline__ float advance_node(const StepParams& s, float weight, int i, const float4& x4,
@@ -242,7 +242,7 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
 }
 
 // Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v) and
-// x_prev (Verlet), writes (xo, vo). x_prev may alias xo.
+// x_prev (Verlet), writes (xo, vo).
 // With kPrefetchAhead each thread first asks L2 for the state of the node `prefetch` after its
 // own, which a block launched later reads: its loads then wait on L2 rather than on DRAM (H100,
 // paper scene: semi-implicit Euler 4% and Verlet 5% faster at 2048^2, Verlet 6% at 8192^2,

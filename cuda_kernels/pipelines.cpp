@@ -131,7 +131,7 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   b += n * 2 * f4 * s.stage_states;
   const bool one_kernel = (o.variant == Variant::fused || o.variant == Variant::temporal) && s.single_pass();
   if (!one_kernel) b += n * f4 * s.accel_slots;
-  if (o.variant == Variant::temporal && s.rule == UpdateRule::verlet) b += n * 2 * f4;  // previous positions' pair
+  if (s.rule == UpdateRule::verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
   b += (n / 32 + 1024) * 4 * 2;  // the stop rule's warp maxima (tile padding at most doubles them)
   return b + spring_bytes(m, o.variant);
 }

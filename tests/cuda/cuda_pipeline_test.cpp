@@ -187,18 +187,21 @@ TEST(CudaPipeline, RefusesASizeThatDoesNotFit) {
   }
   const Model m = make_model(kShapes[4]);
   EXPECT_NO_THROW(cuda::require_device_memory(cuda::bytes_needed(m.size(), Integrator::rk4, {}), "a 256x256 cloth"));
-  // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers; every
-  // pipeline the stop rule's warp maxima (a word per 32 nodes, room for tile padding).
+  // RK4 holds 3 stage states and 4 accelerations besides the two (x, v) buffers, Verlet a
+  // third (x, v) set (cuda-temporal: a pair of previous positions); every pipeline the stop
+  // rule's warp maxima (a word per 32 nodes, room for tile padding).
   const std::int64_t stop = (m.node_count() / 32 + 1024) * 8;
   EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::rk4, options(Variant::naive)),
             m.node_count() * 16 * (4 + 6 + 4) + stop);
-  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 4 + stop);
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::fused)), m.node_count() * 16 * 6 + stop);
+  EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::temporal)),
+            m.node_count() * 16 * 6 + stop);
   // Grids need no spring arrays, not even for scatter; a general model's adjacency or spring list adds its bytes.
   EXPECT_EQ(cuda::bytes_needed(m.size(), Integrator::verlet, options(Variant::scatter)),
-            m.node_count() * 16 * 5 + stop);
+            m.node_count() * 16 * 7 + stop);
   const ModelSize g = explicit_springs(m).size();
   EXPECT_EQ(cuda::bytes_needed(g, Integrator::verlet, options(Variant::scatter)),
-            m.node_count() * 16 * 5 + stop + g.springs * 20);
+            m.node_count() * 16 * 7 + stop + g.springs * 20);
 }
 
 // ---- no device needed ----
