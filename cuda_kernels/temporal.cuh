@@ -94,7 +94,7 @@ struct Region {
 // Reads (x, v) and x_prev (Verlet), writes k = `steps` steps later (xo, vo) and, for Verlet,
 // the positions one step before those (po). x_prev is not read when has_prev is false.
 // Shared memory: two copies of (x, v) per region cell; Verlet's new positions overwrite the
-// copy holding the previous ones, cell by cell, as in fused_grid.
+// copy holding the previous ones, cell by cell.
 template <int N, bool Damped, int Rule>
 __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
     temporal_grid(StepParams s, Stencil st, float weight, int steps, int3 tile, const float4* __restrict__ x,
