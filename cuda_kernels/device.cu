@@ -84,7 +84,8 @@ double median_event_ms(int warmup, int batches, int per_batch, Work&& work, cons
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
 // and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous:
 // read from the array x is written to, where cuda-fused reads a third array; the same bytes),
-// and writes x and v with the neighbours' components summed in, so that no load is dead. Neighbours outside the grid are skipped; loads go Group at a time.
+// and writes x and v with the neighbours' components summed in, so that no load is dead.
+// Neighbours outside the grid are skipped; loads go Group at a time.
 template <bool Velocities, bool Previous, int Group>
 __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v, float4* xo,
                              float4* __restrict__ vo) {
