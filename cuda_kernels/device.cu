@@ -82,18 +82,18 @@ double median_event_ms(int warmup, int batches, int per_batch, Work&& work, cons
 }
 
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
-// and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous:
-// read from the array x is written to, where cuda-fused reads a third array; the same bytes),
-// and writes x and v with the neighbours' components summed in, so that no load is dead.
+// and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous,
+// from a third array, as cuda-fused's), and writes x and v with the neighbours' components
+// summed in, so that no load is dead.
 // Neighbours outside the grid are skipped; loads go Group at a time.
 template <bool Velocities, bool Previous, int Group>
-__global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v, float4* xo,
-                             float4* __restrict__ vo) {
+__global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v,
+                            const float4* __restrict__ xp, float4* __restrict__ xo, float4* __restrict__ vo) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y;
   if (i >= n || j >= n) return;
   const int node = j * n + i;
   float4 sx = x[node], sv = v[node];
-  if (Previous) sx.w += xo[node].x;
+  if (Previous) sx.w += xp[node].x;
   const bool inside = i >= 2 && i < n - 2 && j >= 2 && j < n - 2;
 #pragma unroll
   for (int g = 0; g < kClothStencil; g += Group) {
@@ -131,17 +131,18 @@ double copy_ms(std::int64_t bytes, int reps) {
 
 double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches) {
   const std::int64_t nodes = std::int64_t(n) * n;
-  require_device_memory(4 * nodes * std::int64_t(sizeof(float4)), "the bare gather");
-  Buffer<float4> x, v, xo, vo;
+  require_device_memory((previous ? 5 : 4) * nodes * std::int64_t(sizeof(float4)), "the bare gather");
+  Buffer<float4> x, v, xp, xo, vo;
   x.allocate(std::size_t(nodes), "allocating the bare gather's positions");
   v.allocate(std::size_t(nodes), "allocating the bare gather's velocities");
+  xp.allocate(std::size_t(previous ? nodes : 1), "allocating the bare gather's previous positions");
   xo.allocate(std::size_t(nodes), "allocating the bare gather's output positions");
   vo.allocate(std::size_t(nodes), "allocating the bare gather's output velocities");
-  for (const Buffer<float4>* b : {&x, &v, &xo, &vo})
+  for (const Buffer<float4>* b : {&x, &v, &xp, &xo, &vo})
     check(cudaMemset(b->get(), 0x3c, b->size() * sizeof(float4)), "filling the bare gather's arrays");
   const dim3 threads(unsigned(tile.x), unsigned(tile.y)),
       blocks(unsigned((n + tile.x - 1) / tile.x), unsigned((n + tile.y - 1) / tile.y));
-  using Kernel = void (*)(int, const float4*, const float4*, float4*, float4*);
+  using Kernel = void (*)(int, const float4*, const float4*, const float4*, float4*, float4*);
   auto pick = [&](auto group) -> Kernel {
     constexpr int g = decltype(group)::value;
     return velocities ? (previous ? bare_gather<true, true, g> : bare_gather<true, false, g>)
@@ -151,7 +152,7 @@ double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batc
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
                               pick(std::integral_constant<int, 4>{})})
     best = std::min(best, median_event_ms(10, batches, 10, [&] {
-      kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get());
+      kernel<<<blocks, threads>>>(n, x.get(), v.get(), xp.get(), xo.get(), vo.get());
     }, "the bare gather"));
   return best;
 }
