@@ -11,8 +11,8 @@
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
 # timing part's experiment cells again).
-# The build folder can travel as .dev/*.tar.xz (scripts/pack-for-device.sh: a base and a program an
-# archive), unpacked here.
+# The build folder can travel as .dev/*.tar.xz (scripts/pack-for-device.sh: the tree and its
+# programs), unpacked here.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 for t in .dev/*.tar.xz; do [ -f "$t" ] && xz -dc "$t" | tar -xf -; done
@@ -39,7 +39,7 @@ if part tests; then
     /^      "name" :/ { name = $0; sub(/^ *"name" : "/, "", name); sub(/",?$/, "", name); print prog "|" name }')
   if [ ${#missing[@]} -gt 0 ]; then
     echo "gpu-check: the tests part needs what is not here: $(printf '%s\n' "${missing[@]}" | sort -u | head -3 |
-      paste -sd ';' | sed 's/;/; /g') (carry the .dev archives of their programs: scripts/pack-for-device.sh)" >&2
+      paste -sd ';' | sed 's/;/; /g') (carry .dev/programs.tar.xz: scripts/pack-for-device.sh)" >&2
     exit 2
   fi
   ctest --test-dir "$build" -j"${JOBS:-4}" ${LABELS:+-L "$LABELS"} --output-on-failure >"$out/ctest.log" 2>&1
