@@ -207,12 +207,15 @@ scale_run() {  # name, then run arguments
   summary+=("scale $name (rc $rc, GPU peak ${peak} MiB): $(grep -E 'median|memory:|error|refused|limit' "$out/scale-$name.log" | tr -s ' ' | tr '\n' ' ')")
 }
 if part scale; then
-  for p in cuda-fused cuda-naive glsl-compute; do
-    scale_run "$p-cloth16384" --pipeline "$p" --grid 16384x16384
-    scale_run "$p-lattice512" --pipeline "$p" --lattice 512x512x512
+  for suffix in "" -fast; do  # exact math (the default), then fast math
+    math=(); [ -n "$suffix" ] && math=(--option math=fast)
+    for p in cuda-fused cuda-naive glsl-compute; do
+      scale_run "$p-cloth16384$suffix" --pipeline "$p" --grid 16384x16384 "${math[@]}"
+      scale_run "$p-lattice512$suffix" --pipeline "$p" --lattice 512x512x512 "${math[@]}"
+    done
+    scale_run "glsl-tf-cloth11585$suffix" --pipeline glsl-tf --grid 11585x11585 "${math[@]}"
+    scale_run "glsl-tf-lattice512$suffix" --pipeline glsl-tf --lattice 512x512x512 "${math[@]}"
   done
-  scale_run glsl-tf-cloth11585 --pipeline glsl-tf --grid 11585x11585
-  scale_run glsl-tf-lattice512 --pipeline glsl-tf --lattice 512x512x512
   scale_run glsl-tf-cloth16384 --pipeline glsl-tf --grid 16384x16384
   scale_run glsl-compute-frames16384 --pipeline glsl-compute --grid 16384x16384 --frames 20
   scale_run cuda-fused-frames16384 --pipeline cuda-fused --grid 16384x16384 --frames 20
