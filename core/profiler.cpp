@@ -21,6 +21,11 @@ double median(std::vector<double> v) {
 
 Profiler::Profiler() : t0_(std::chrono::steady_clock::now()) {}
 
+std::string Profiler::sampling() const {
+  if (every_ <= 1) return "every step";
+  return "steps 1-" + std::to_string(kSampleWindow) + " of every " + std::to_string(every_ * kSampleWindow);
+}
+
 double Profiler::now_ms() const {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
 }

@@ -44,6 +44,15 @@ class Profiler {
   double now_ms() const;
   void set_step(int step) { step_ = step; }
   int step() const { return step_; }
+  // Pipelines time their stages (events or queries around each pass, which the device runs
+  // too) only in steps the profiler samples: all of them by default, else the windows of
+  // kSampleWindow steps that begin at step 1, 1 + every x kSampleWindow, ... (a window holds a
+  // whole launch of up to 8 steps). Steps before the first (0) are always sampled.
+  static constexpr int kSampleWindow = 8;
+  void sample_every(int windows) { every_ = windows; }
+  bool sampled() const { return every_ <= 1 || step_ <= 0 || (step_ - 1) / kSampleWindow % every_ == 0; }
+  // What the sampling covers, as a user reads it.
+  std::string sampling() const;
   void add(Span s);
   // The spans kept (all of them, unless streamed without keeping them).
   const std::vector<Span>& spans() const { return spans_; }
@@ -84,7 +93,11 @@ class Profiler {
   std::string stream_path_;
   bool keep_ = true;
   int step_ = 0;
+  int every_ = 1;
 };
+
+// The profiler to time this step's stages with: `p` where it samples the step, else null.
+inline Profiler* sampling(Profiler* p) { return p && p->sampled() ? p : nullptr; }
 
 // An NVTX range named like the span it covers, for as long as the object lives.
 class NvtxRange {

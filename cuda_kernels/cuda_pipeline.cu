@@ -167,7 +167,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   void step() override {
     if (temporal_) return hold_step();
     // Profiled steps run pass by pass (a graph replay has no spans).
-    const bool replay = !prof_ && o_.graphs && time_invariant() && !(sched_.rule == UpdateRule::verlet && !has_prev_);
+    const bool replay = !sampling(prof_) && o_.graphs && time_invariant() && !(sched_.rule == UpdateRule::verlet && !has_prev_);
     if (replay) {
       if (!graph_[cur_]) capture(cur_);
       check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");
@@ -390,8 +390,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // EventSpans::begin).
   template <class F>
   void timed(const char* name, F&& launch, int steps = 1) {
-    if (!prof_) return launch();
-    spans_.begin(*prof_, name, stream_, steps);
+    Profiler* p = sampling(prof_);
+    if (!p) return launch();
+    spans_.begin(*p, name, stream_, steps);
     launch();
     spans_.end(stream_);
     if (spans_.pending() > 1024) spans_.collect(prof_);

@@ -409,13 +409,13 @@ void GlPipeline::bind_textures(int stage) const {
 
 void GlPipeline::step() {
   // With an outside force stage, its pipeline times the passes (GL timer spans may not nest).
-  const bool timed = prof_ && !shared_;
-  if (timed) {
+  Profiler* p = shared_ ? nullptr : sampling(prof_);
+  if (p) {
     if (spans_.pending() >= 512) spans_.collect(prof_);
-    spans_.begin(*prof_, span::force_update);
+    spans_.begin(*p, span::force_update);
   }
   run_passes(sched_, t_, p_.dt, *this, *this);
-  if (timed) spans_.end();
+  if (p) spans_.end();
   finish_step();
 }
 

@@ -95,22 +95,24 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
     const auto [x, v] = gl_->slot_buffers(src);
     const GLuint a = gl_->force_buffer();
     const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
+    Profiler* p = sampling(prof_);
     {
-      HostSpan h(prof_, span::hand_off);
+      HostSpan h(p, span::hand_off);
       sb_->to_cuda({x, v, a});
     }
-    if (prof_) force_spans_.begin(*prof_, span::force, sb_->stream());
+    if (p) force_spans_.begin(*p, span::force, sb_->stream());
     fp_->run(static_cast<const float4*>(sb_->cuda_ptr(x)), static_cast<const float4*>(sb_->cuda_ptr(v)),
              static_cast<float4*>(sb_->cuda_ptr(a)), target, sb_->stream());
-    if (prof_) force_spans_.end(sb_->stream());
-    HostSpan h(prof_, span::hand_off);
+    if (p) force_spans_.end(sb_->stream());
+    HostSpan h(p, span::hand_off);
     sb_->to_gl();
   }
 
   void update(const Pass& pass) override {
-    if (prof_) update_spans_.begin(*prof_, span::update);
+    Profiler* p = sampling(prof_);
+    if (p) update_spans_.begin(*p, span::update);
     gl_->update(pass);
-    if (prof_) update_spans_.end();
+    if (p) update_spans_.end();
   }
 
   void collect() {

@@ -100,12 +100,24 @@ TEST(GlErrors, BadMathValueIsBadInput) {
   }
 }
 
-// The command end to end: frames every N steps and the final one, committed with the run.
+// The command end to end: frames every N steps and the final one, committed with the run;
+// the pass's spans in the sampled steps 1-8 of the 12 (every step with --trace).
 TEST(GlCommand, RunWritesFramesAndGlFacts) {
   DEFORMLAB_REQUIRE_GL();
   const auto dir = temp_dir("run");
+  auto pass_spans = [&] {
+    std::ifstream csv(dir / "out" / "spans.csv");
+    int n = 0;
+    for (std::string line; std::getline(csv, line);) n += line.rfind("force+update,", 0) == 0;
+    return n;
+  };
+  const Command traced = run_deformlab("", "run -p glsl-compute --grid 16x16 --steps 12 --trace -o '" + (dir / "out").string() + "'");
+  EXPECT_EQ(traced.exit_code, 0) << traced.output;
+  EXPECT_EQ(pass_spans(), 12);
+  std::filesystem::remove_all(dir / "out");
   const Command c = run_deformlab("", "run -p glsl-compute --grid 16x16 --steps 12 --frames 5 -o '" + (dir / "out").string() + "'");
   EXPECT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_EQ(pass_spans(), 8);
   for (const char* f : {"frame_000005.png", "frame_000010.png", "frame_000012.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frames" / f)) << f;
   std::ifstream manifest(dir / "out" / "manifest.json");

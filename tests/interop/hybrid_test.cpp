@@ -3,6 +3,8 @@
 // be bitwise equal) and the spans of each stage. Against the CPU: tests/match.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "core/cpu_backend.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
 #include "interop/hybrid.hpp"
@@ -73,32 +75,38 @@ INSTANTIATE_TEST_SUITE_P(Hybrid, ModesAgree,
                            return s;
                          });
 
-// A profiled run records the force, hand-off and update spans of every step, each with its clock.
+// A profiled run records the force, hand-off and update spans of every step it samples (all
+// of them, or steps 1-8 and 17-20 of 20 with one window of 8 in 2), each with its clock.
 TEST(HybridProfile, SpansPerStage) {
   DEFORMLAB_REQUIRE_INTEROP(Mode::map);
   const Scenario sc = scenario(Integrator::midpoint);
-  auto p = make_hybrid_pipeline({sc.model, sc.params, Integrator::midpoint}, {});
-  Profiler prof;
-  p->set_state(sc.s0);
-  p->set_profiler(&prof);
-  for (int k = 1; k <= 5; ++k) {
-    prof.set_step(k);
-    p->step();
-  }
-  p->set_profiler(nullptr);
-  int force = 0, hand_off = 0, update = 0;
-  for (const Span& s : prof.spans()) {
-    EXPECT_GE(s.ms, 0.0) << s.name;
-    force += s.name == span::force;
-    hand_off += s.name == span::hand_off;
-    update += s.name == span::update;
-    if (s.name == span::force) {
-      EXPECT_EQ(s.clock, "CUDA events");
+  for (const auto& [every, steps, sampled] : {std::tuple{1, 5, 5}, std::tuple{2, 20, 12}}) {
+    SCOPED_TRACE(every);
+    auto p = make_hybrid_pipeline({sc.model, sc.params, Integrator::midpoint}, {});
+    Profiler prof;
+    prof.sample_every(every);
+    p->set_state(sc.s0);
+    p->set_profiler(&prof);
+    for (int k = 1; k <= steps; ++k) {
+      prof.set_step(k);
+      p->step();
     }
+    p->set_profiler(nullptr);
+    int force = 0, hand_off = 0, update = 0;
+    for (const Span& s : prof.spans()) {
+      EXPECT_GE(s.ms, 0.0) << s.name;
+      EXPECT_TRUE(s.step <= 8 || s.step > 16) << s.name << " in step " << s.step;
+      force += s.name == span::force;
+      hand_off += s.name == span::hand_off;
+      update += s.name == span::update;
+      if (s.name == span::force) {
+        EXPECT_EQ(s.clock, "CUDA events");
+      }
+    }
+    EXPECT_EQ(force, sampled * 2);  // midpoint: two force passes per step
+    EXPECT_EQ(hand_off, sampled * 2 * 2);
+    EXPECT_EQ(update, sampled * 2);
   }
-  EXPECT_EQ(force, 5 * 2);  // midpoint: two force passes per step
-  EXPECT_EQ(hand_off, 5 * 2 * 2);
-  EXPECT_EQ(update, 5 * 2);
 }
 
 }  // namespace

@@ -32,6 +32,8 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_EQ(m["result"]["step_clock"], "host clock");
   EXPECT_GT(m["result"]["median_step_ms"].get<double>(), 0.0);
   EXPECT_NE(r.out.find("ms/step (host clock), "), std::string::npos) << r.out;
+  EXPECT_EQ(m["stages_timed_in"], "steps 1-8 of every 64");
+  EXPECT_NE(r.out.find("passes timed in steps 1-8 of every 64"), std::string::npos) << r.out;
   EXPECT_EQ(m["scene"]["model"]["size"], nlohmann::json::array({8, 6}));
   EXPECT_LT(m["compare"]["max_position_error_relative_to_extent"].get<double>(), 1e-5);
   EXPECT_TRUE(m["build"].contains("compiler"));

@@ -35,6 +35,26 @@ TEST(Profiler, SummarySumsSpansPerStepThenTakesTheMedian) {
   EXPECT_DOUBLE_EQ(s[1].median_ms, 0.5);
 }
 
+// Sampling: every step by default; else windows of 8 steps from step 1, one in `every`.
+TEST(Profiler, SamplesWindowsOfStepsFromTheFirst) {
+  Profiler p;
+  EXPECT_EQ(p.sampling(), "every step");
+  p.sample_every(3);
+  EXPECT_EQ(p.sampling(), "steps 1-8 of every 24");
+  std::vector<int> sampled;
+  for (int step = 0; step <= 60; ++step) {
+    p.set_step(step);
+    if (p.sampled()) sampled.push_back(step);
+    EXPECT_EQ(sampling(&p), p.sampled() ? &p : nullptr);
+  }
+  EXPECT_EQ(sampled, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 25, 26, 27, 28, 29, 30, 31, 32, 49, 50, 51, 52,
+                                       53, 54, 55, 56}));
+  EXPECT_EQ(sampling(nullptr), nullptr);
+  p.sample_every(1);
+  p.set_step(13);
+  EXPECT_TRUE(p.sampled());
+}
+
 // Streamed spans: the file holds what write_csv writes, the summary is the same, and
 // without keeping them the profiler holds no spans (a long run's memory stays flat).
 TEST(Profiler, StreamsSpansWithTheSameSummary) {
