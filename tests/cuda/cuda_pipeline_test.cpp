@@ -327,18 +327,8 @@ TEST(CudaProfile, SpansOnlyInTheSampledSteps) {
   for (const auto integ : {Integrator::semi_implicit_euler, Integrator::verlet}) {
     SCOPED_TRACE(info(integ).name);
     auto profiled = cuda::make_pipeline({m, p, integ}, {cuda::Variant::fused});
-    Profiler prof;
-    prof.sample_every(2);
-    profiled->set_state(s0);
-    profiled->set_profiler(&prof);
-    for (int k = 1; k <= 24; ++k) {
-      prof.set_step(k);
-      profiled->step();
-    }
-    profiled->set_profiler(nullptr);
-    std::vector<int> steps;
-    for (const Span& s : prof.spans()) steps.push_back(s.step);
-    EXPECT_EQ(steps, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20, 21, 22, 23, 24}));
+    EXPECT_EQ(sampled_span_steps(*profiled, s0, 24, 2),
+              (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20, 21, 22, 23, 24}));
     auto plain = cuda::make_pipeline({m, p, integ}, {cuda::Variant::fused});
     EXPECT_TRUE(bitwise_equal(advance(*plain, s0, 24), profiled->state()));
   }

@@ -199,18 +199,8 @@ TEST(CudaTemporal, SpansOnlyInTheSampledLaunches) {
   DEFORMLAB_REQUIRE_CUDA();
   const Model m = small_cloth(64, 64);
   auto t = cuda::make_pipeline({m, small_params(), Integrator::semi_implicit_euler}, temporal(4, {}, Math::exact));
-  Profiler prof;
-  prof.sample_every(2);
-  t->set_state(rest_state(m));
-  t->set_profiler(&prof);
-  for (int k = 1; k <= 24; ++k) {
-    prof.set_step(k);
-    t->step();
-  }
-  t->set_profiler(nullptr);
-  std::vector<int> steps;
-  for (const Span& s : prof.spans()) steps.push_back(s.step);
-  EXPECT_EQ(steps, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20, 21, 22, 23, 24}));
+  EXPECT_EQ(sampled_span_steps(*t, rest_state(m), 24, 2),
+            (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20, 21, 22, 23, 24}));
 }
 
 TEST(CudaTemporal, RefusesWhatItDoesNotRun) {

@@ -48,18 +48,8 @@ TEST(GlProfile, SpansOnlyInTheSampledSteps) {
   const Model m = small_cloth(16, 12);
   const Params p = small_params();
   auto pipe = make_gl("glsl-compute", {m, p, Integrator::semi_implicit_euler});
-  pipe->set_state(perturbed_state(m, 3));
-  Profiler prof;
-  prof.sample_every(2);
-  pipe->set_profiler(&prof);
-  for (int k = 1; k <= 20; ++k) {
-    prof.set_step(k);
-    pipe->step();
-  }
-  pipe->set_profiler(nullptr);
-  std::vector<int> steps;
-  for (const Span& s : prof.spans()) steps.push_back(s.step);
-  EXPECT_EQ(steps, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20}));
+  EXPECT_EQ(sampled_span_steps(*pipe, perturbed_state(m, 3), 20, 2),
+            (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20}));
   auto plain = make_gl("glsl-compute", {m, p, Integrator::semi_implicit_euler});
   EXPECT_TRUE(bitwise_equal(advance(*plain, perturbed_state(m, 3), 20), pipe->state()));
 }

@@ -5,6 +5,8 @@
 #include <limits>
 #include <random>
 
+#include "core/profiler.hpp"
+
 namespace deformlab::test {
 
 Model small_cloth(int nx, int ny, bool pinned) {
@@ -113,6 +115,21 @@ State advance(Pipeline& p, const State& s0, int steps) {
   p.set_state(s0);
   for (int k = 0; k < steps; ++k) p.step();
   return p.state();
+}
+
+std::vector<int> sampled_span_steps(Pipeline& p, const State& s0, int steps, int every) {
+  Profiler prof;
+  prof.sample_every(every);
+  p.set_state(s0);
+  p.set_profiler(&prof);
+  for (int k = 1; k <= steps; ++k) {
+    prof.set_step(k);
+    p.step();
+  }
+  p.set_profiler(nullptr);  // collects the pending spans
+  std::vector<int> at;
+  for (const Span& s : prof.spans()) at.push_back(s.step);
+  return at;
 }
 
 }  // namespace deformlab::test

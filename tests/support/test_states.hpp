@@ -1,6 +1,7 @@
 // Shared helpers for tests that compare pipelines: small scenes and non-trivial states.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "core/integrator.hpp"
 #include "core/mesh_model.hpp"
@@ -45,5 +46,9 @@ bool bitwise_equal(const State& a, const State& b);
 
 // Runs `steps` steps of a pipeline made by `make` from state `s0` and returns the state.
 State advance(Pipeline& p, const State& s0, int steps);
+
+// Runs `steps` steps from `s0` with a profiler sampling one window of steps in `every`
+// (Profiler::sample_every) and returns the step of each span it took, in order.
+std::vector<int> sampled_span_steps(Pipeline& p, const State& s0, int steps, int every);
 
 }  // namespace deformlab::test
