@@ -140,7 +140,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
                   {"median_step_ms", med.step_ms}, {"step_clock", r.clock},
                   {"median_queue_ms_host_clock", med.queue_ms}, {"stage_timing", pipe.timing_method()}}},
       {"stages", stages_of(profiler)},
-      {"stages_timed_in", profiler.sampling()},
+      {"stages_timed_in", profiler.sampled_steps()},
       {"files", {{"timings.csv", "per step: step, t_s, step_ms (on the step clock), queue_ms (host clock around "
                                  "the call that queues the step), max_displacement_m"},
                  {"spans.csv", "per span: name, step, start_ms (host clock), ms, clock (how it was timed); the "
@@ -177,7 +177,7 @@ void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r,
   if (a.compare)
     std::cout << "  compare: largest position error vs the double reference: "
               << compare["max_position_error_relative_to_extent"].get<double>() << " of the model's extent\n";
-  std::cout << "  where a step's time goes (median per step; passes timed in " << profiler.sampling() << "):\n";
+  std::cout << "  where a step's time goes (median per step; passes timed in " << profiler.sampled_steps() << "):\n";
   for (const auto& g : profiler.summary())
     std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
               << " ms  (" << g.clock << ")\n";

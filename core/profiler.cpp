@@ -21,7 +21,7 @@ double median(std::vector<double> v) {
 
 Profiler::Profiler() : t0_(std::chrono::steady_clock::now()) {}
 
-std::string Profiler::sampling() const {
+std::string Profiler::sampled_steps() const {
   if (every_ <= 1) return "every step";
   return "steps 1-" + std::to_string(kSampleWindow) + " of every " + std::to_string(every_ * kSampleWindow);
 }

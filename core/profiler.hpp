@@ -52,7 +52,7 @@ class Profiler {
   void sample_every(int windows) { every_ = windows; }
   bool sampled() const { return every_ <= 1 || step_ <= 0 || (step_ - 1) / kSampleWindow % every_ == 0; }
   // What the sampling covers, as a user reads it.
-  std::string sampling() const;
+  std::string sampled_steps() const;
   void add(Span s);
   // The spans kept (all of them, unless streamed without keeping them).
   const std::vector<Span>& spans() const { return spans_; }

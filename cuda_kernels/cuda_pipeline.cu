@@ -166,8 +166,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
 
   void step() override {
     if (temporal_) return hold_step();
-    // Profiled steps run pass by pass (a graph replay has no spans).
-    const bool replay = !sampling(prof_) && o_.graphs && time_invariant() && !(sched_.rule == UpdateRule::verlet && !has_prev_);
+    // Steps the profiler samples run pass by pass (a graph replay has no spans).
+    const bool replay = !sampling(prof_) && o_.graphs && time_invariant() &&
+                        !(sched_.rule == UpdateRule::verlet && !has_prev_);
     if (replay) {
       if (!graph_[cur_]) capture(cur_);
       check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");

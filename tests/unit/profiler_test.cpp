@@ -38,9 +38,9 @@ TEST(Profiler, SummarySumsSpansPerStepThenTakesTheMedian) {
 // Sampling: every step by default; else windows of 8 steps from step 1, one in `every`.
 TEST(Profiler, SamplesWindowsOfStepsFromTheFirst) {
   Profiler p;
-  EXPECT_EQ(p.sampling(), "every step");
+  EXPECT_EQ(p.sampled_steps(), "every step");
   p.sample_every(3);
-  EXPECT_EQ(p.sampling(), "steps 1-8 of every 24");
+  EXPECT_EQ(p.sampled_steps(), "steps 1-8 of every 24");
   std::vector<int> sampled;
   for (int step = 0; step <= 60; ++step) {
     p.set_step(step);
