@@ -46,8 +46,9 @@ class Profiler {
   int step() const { return step_; }
   // Pipelines time their stages (events or queries around each pass, which the device runs
   // too) only in steps the profiler samples: all of them by default, else the windows of
-  // kSampleWindow steps that begin at step 1, 1 + every x kSampleWindow, ... (a window holds a
-  // whole launch of up to 8 steps). Steps before the first (0) are always sampled.
+  // kSampleWindow steps that begin at step 1, 1 + every x kSampleWindow, ... (a launch of up
+  // to 8 steps, timed at its last step, ends in every window). Steps before the first (0) are
+  // always sampled.
   static constexpr int kSampleWindow = 8;
   void sample_every(int windows) { every_ = windows; }
   bool sampled() const { return every_ <= 1 || step_ <= 0 || (step_ - 1) / kSampleWindow % every_ == 0; }

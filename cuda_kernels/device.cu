@@ -84,8 +84,8 @@ double median_event_ms(int warmup, int batches, int per_batch, Work&& work, cons
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
 // and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous,
 // from a third array, as cuda-fused's), and writes x and v with the neighbours' components
-// summed in, so that no load is dead.
-// Neighbours outside the grid are skipped; loads go Group at a time.
+// summed in, so that no load is dead. Neighbours outside the grid are skipped; loads go Group
+// at a time.
 template <bool Velocities, bool Previous, int Group>
 __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v,
                             const float4* __restrict__ xp, float4* __restrict__ xo, float4* __restrict__ vo) {
