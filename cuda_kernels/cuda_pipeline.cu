@@ -443,9 +443,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
                                                                 tg.end, stop_check());
       check_launch("launching the update kernel");
     } else if (!model_.grid()) {
-      dev::fused_csr<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp,
-                                                                   has_prev_, xo, vo, tg,
-                                                                   stop_check());
+      const auto kernel = damped_ ? dev::fused_csr<Rule, true> : dev::fused_csr<Rule, false>;
+      kernel<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp, has_prev_, xo, vo,
+                                                     tg, stop_check());
       check_launch("launching the fused CSR step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {

@@ -86,8 +86,8 @@ class ForceKernels {
       return;
     }
     if (!model_.grid()) {
-      dev::force_csr<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, offset_.get(), links_.get(), x, v, acc,
-                                                                        target);
+      const auto kernel = damped_ ? dev::force_csr<true> : dev::force_csr<false>;
+      kernel<<<blocks_for(sp_.node_count), kBlock, 0, stream>>>(sp_, offset_.get(), links_.get(), x, v, acc, target);
       check_launch("launching the CSR gather force kernel");
       return;
     }

@@ -107,14 +107,16 @@ __device__ __forceinline__ Vec3f gather_grid(const StepParams& s, const Stencil&
   return gather_stencil<N, Damped, true>(s, st, i, j, k, xi, vi, w);
 }
 
-// Sum of spring forces on node i from its CSR adjacency (general models).
+// Sum of spring forces on node i from its CSR adjacency (general models). Undamped models
+// do not read the neighbours' velocities (kd = 0 makes the damping term 0 either way).
+template <bool Damped>
 __device__ __forceinline__ Vec3f gather_csr(const int* __restrict__ offset, const Link* __restrict__ links,
                                             const float4* __restrict__ x, const float4* __restrict__ v, int i,
                                             const Vec3f& xi, const Vec3f& vi) {
   Vec3f f{};
   for (int e = offset[i]; e < offset[i + 1]; ++e) {
     const Link l = links[e];
-    f += P::spring_force(xi, xyz(x[l.node]), vi, xyz(v[l.node]), l.k, l.kd, l.rest);
+    f += P::spring_force(xi, xyz(x[l.node]), vi, Damped ? xyz(v[l.node]) : vi, l.k, l.kd, l.rest);
   }
   return f;
 }
@@ -276,25 +278,27 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil s
 // ---- general models: one thread per node over the CSR adjacency ----
 
 // Node i's acceleration; pinned and hard-dragged nodes skip the gather.
+template <bool Damped>
 __device__ __forceinline__ Vec3f csr_accel(const StepParams& s, const int* __restrict__ offset,
                                            const Link* __restrict__ links, const float4* __restrict__ x,
                                            const float4* __restrict__ v, int i, const float4& x4, const float4& v4,
                                            const Vec3f& drag_target) {
   if (P::node_fixed(s, i, x4.w)) return {};
   const Vec3f xi = xyz(x4), vi = xyz(v4);
-  return P::node_acceleration(s, i, x4.w, xi, vi, gather_csr(offset, links, x, v, i, xi, vi), drag_target);
+  return P::node_acceleration(s, i, x4.w, xi, vi, gather_csr<Damped>(offset, links, x, v, i, xi, vi), drag_target);
 }
 
+template <bool Damped>
 __global__ void force_csr(StepParams s, const int* __restrict__ offset, const Link* __restrict__ links,
                           const float4* __restrict__ x, const float4* __restrict__ v, float4* __restrict__ acc,
                           Vec3f drag_target) {
   const std::int64_t t = thread_index();
   if (t >= s.node_count) return;
   const int i = int(t);
-  acc[i] = f4(csr_accel(s, offset, links, x, v, i, x[i], v[i], drag_target), 0.f);
+  acc[i] = f4(csr_accel<Damped>(s, offset, links, x, v, i, x[i], v[i], drag_target), 0.f);
 }
 
-template <int Rule>
+template <int Rule, bool Damped>
 __global__ void fused_csr(StepParams s, float weight, const int* __restrict__ offset, const Link* __restrict__ links,
                           const float4* __restrict__ x, const float4* __restrict__ v, const float4* x_prev,
                           bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg, StopCheck check) {
@@ -303,7 +307,7 @@ __global__ void fused_csr(StepParams s, float weight, const int* __restrict__ of
   if (t < s.node_count) {
     const int i = int(t);
     const float4 x4 = x[i], v4 = v[i];
-    const Vec3f a = csr_accel(s, offset, links, x, v, i, x4, v4, tg.force);
+    const Vec3f a = csr_accel<Damped>(s, offset, links, x, v, i, x4, v4, tg.force);
     d = advance_node<Rule>(s, weight, i, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
   }
   store_displacement(check, d);
