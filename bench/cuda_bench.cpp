@@ -98,7 +98,7 @@ class Report {
   // node) or Verlet (80), on cuda-fused's block in fast math.
   Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
     const Model& m = scene.model;
-    const bool damped = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
+    const bool damped = m.damped();
     const int n = m.nx;
     const cuda::Tile tile = cuda::default_tile(cuda::Variant::fused, Math::fast, m.topology);
     Row r;

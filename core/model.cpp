@@ -42,6 +42,12 @@ std::int64_t Model::spring_count() const {
   return k[0] + k[1] + k[2];
 }
 
+bool Model::damped() const {
+  const auto nonzero = [](float d) { return d != 0.f; };
+  if (grid() || spring_damping.empty()) return std::any_of(damping.begin(), damping.end(), nonzero);
+  return std::any_of(spring_damping.begin(), spring_damping.end(), nonzero);
+}
+
 std::int64_t Model::host_bytes() const {
   auto bytes = [](const auto& v) { return std::int64_t(v.capacity() * sizeof(v[0])); };
   return bytes(rest_position) + bytes(inv_mass) + bytes(spring_i) + bytes(spring_j) + bytes(rest_length) +

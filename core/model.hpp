@@ -62,6 +62,8 @@ struct Model {
   // Constants of general spring e.
   float spring_k(int e) const { return spring_stiffness.empty() ? stiffness[int(kind[e])] : spring_stiffness[e]; }
   float spring_kd(int e) const { return spring_damping.empty() ? damping[int(kind[e])] : spring_damping[e]; }
+  // Whether any spring is damped (a kernel may then skip the neighbours' velocities).
+  bool damped() const;
   // Recomputes adj_* from spring_i/j (ordered by spring index within each node).
   void build_adjacency();
   // Node v's index in the mesh as loaded (v itself unless the nodes were reordered).

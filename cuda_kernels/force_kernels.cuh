@@ -46,7 +46,6 @@ class ForceKernels {
  public:
   ForceKernels(const Model& m, const Params& p, const Options& o)
       : model_(m), o_(o), sp_(step_params<float>(m, p)) {
-    damped_ = std::any_of(m.damping.begin(), m.damping.end(), [](float d) { return d != 0.f; });
     if (m.grid()) {
       const auto entries = stencil_entries<float>(m);
       std::copy(entries.begin(), entries.end(), stencil_.e);
@@ -117,7 +116,6 @@ class ForceKernels {
   void upload_tiling() {
     const Tiling t = tile_model(model_, o_.tile.x * o_.tile.y);
     const std::vector<Link> links = links_of(t.link_cell, t.link_spring);
-    damped_ = std::any_of(links.begin(), links.end(), [](const Link& l) { return l.kd != 0.f; });
     tiles_ = unsigned(t.blocks());
     tile_threads_ = unsigned(o_.tile.x * o_.tile.y);
     tile_shared_ = std::size_t(t.largest_tile()) * sizeof(float4) * (damped_ ? 2 : 1);
@@ -182,7 +180,7 @@ class ForceKernels {
 
   const Model& model_;
   Options o_;
-  bool damped_ = false;
+  const bool damped_ = model_.damped();
   dev::StepParams sp_;
   Stencil stencil_{};
   Buffer<int> offset_;  // CSR offsets: per node, or per tile cell (cuda-tiled)

@@ -49,6 +49,7 @@ const Shape kShapes[] = {
     {"general32", 32, 32, 0, true, true},       {"contact37x53", 37, 53, 0, true, false, true},
     {"surface30x20", 30, 20, 0, true, true, false, Shape::surface},
     {"volume8x6x5", 8, 6, 5, true, true, false, Shape::volume},
+    {"general11x7", 11, 7, 0, false, true},  // undamped adjacency: no neighbour velocities read
 };
 
 // Option values tried beyond the defaults, by option name (PipelineEntry::options), the
@@ -64,13 +65,13 @@ struct OptionValues {
 const std::vector<Integrator> kOnePassAndRk4 = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
                                                 Integrator::verlet, Integrator::rk4};
 const OptionValues kOptionValues[] = {
-    {"force", {"tiled", "scatter"}, {0, 3, 7, 8}},
+    {"force", {"tiled", "scatter"}, {0, 3, 7, 8, 9}},
     {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
     {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
     {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
     // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
     {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},
-    {"math", {"fast"}, {0, 6, 7}, kOnePassAndRk4},  // exact is the default: every case above runs it
+    {"math", {"fast"}, {0, 6, 7, 9}, kOnePassAndRk4},  // exact is the default: every case above runs it
 };
 
 struct Case {

@@ -128,6 +128,20 @@ TEST(Builders, PinSets) {
   EXPECT_TRUE(p.pinned(0) && p.pinned(5) && !p.pinned(1));
 }
 
+// A model is damped when any spring is: by kind, or by the per-spring values that replace them.
+TEST(Builders, DampedWhenAnySpringIs) {
+  Model c = cloth_grid(4, 3, 0.1f, 0.f, Material{});
+  EXPECT_FALSE(c.damped());
+  c.damping[int(SpringKind::flexion)] = 0.01f;
+  EXPECT_TRUE(c.damped());
+  Model g = explicit_springs(cloth_grid(4, 3, 0.1f, 0.f, Material{}));
+  g.spring_damping.assign(std::size_t(g.spring_count()), 0.f);
+  g.damping = {0.02f, 0.02f, 0.02f};  // replaced by the per-spring values
+  EXPECT_FALSE(g.damped());
+  g.spring_damping.back() = 0.5f;
+  EXPECT_TRUE(g.damped());
+}
+
 TEST(Builders, RejectBadSizes) {
   EXPECT_THROW(cloth_grid(0, 5, 0.1f, 0.f, Material{}), std::invalid_argument);
   EXPECT_THROW(lattice(2, -1, 2, 0.1f, 0.f, Material{}), std::invalid_argument);
