@@ -21,6 +21,7 @@ struct RunArgs {
   std::optional<int> gl_device;  // EGL device index for the GL context (GL builds)
   bool trace = false;            // also write trace.json (Chrome trace of the spans)
   bool no_state = false;         // leave out state.ply
+  std::optional<double> warmup_ms;  // untimed steps first (default: kGpuWarmUpMs on GPU pipelines)
 };
 
 struct ViewArgs {

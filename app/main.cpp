@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
   run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)");
   run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");
+  run->add_option("--warmup-ms", a.warmup_ms,
+                  "Untimed steps from rest for at least this long before the run, which then starts from rest "
+                  "(default: 1000 on pipelines with a GPU pass, 0 on CPU ones)");
   run->add_flag("--no-state", a.no_state, "Leave out state.ply (50 bytes a node: 13 GB for a 16384x16384 cloth)");
 
   deformlab::app::ExperimentArgs ex;

@@ -35,14 +35,31 @@ double relative_position_error(const State& s, const State& ref) {
   return err / std::max(norm(hi - lo), 1e-12);
 }
 
+struct WarmUp {
+  int steps = 0;
+  double ms = 0.0;  // host clock
+};
+
 struct Ran {
   RunResult result;
   json frames;  // the frames' manifest with --frames, else null
+  WarmUp warm_up;
 };
 
-// Runs the pipeline from rest with the profiler attached; with --frames, renders into the
-// staged frames/ folder.
+// Untimed steps from rest for --warmup-ms (by default kGpuWarmUpMs where a pass runs on a GPU).
+WarmUp warm_up_from_rest(const RunArgs& a, const RunInput& in, Pipeline& pipe) {
+  const double ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);
+  if (ms <= 0.0) return {};
+  pipe.set_state(rest_state(in.model));
+  const auto t0 = std::chrono::steady_clock::now();
+  const int steps = warm_up([&] { pipe.step(); }, [&] { pipe.max_displacement(); }, 1, ms);
+  return {steps, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()};
+}
+
+// Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
+// renders into the staged frames/ folder.
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {
+  const WarmUp warm = warm_up_from_rest(a, in, pipe);
   pipe.set_state(rest_state(in.model));
   RunOptions opt;
   opt.until_converged = in.until_converged;
@@ -59,7 +76,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
       frames->after_step(pipe, step);
     };
   }
-  Ran ran{run(pipe, in.model, in.params, opt), nullptr};
+  Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm};
   if (frames) {
     frames->finish(pipe, ran.result.steps);
     ran.frames = frames->manifest();
@@ -68,7 +85,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
 #else
   (void)a;
   (void)dir;
-  return {run(pipe, in.model, in.params, opt), nullptr};
+  return {run(pipe, in.model, in.params, opt), nullptr, warm};
 #endif
 }
 
@@ -133,6 +150,8 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
                  {"host_bytes", in.model.host_bytes()}}},
       {"memory", memory_of(in)},
       {"setup", {{"model_build_s", in.build_s}, {"pipeline_setup_s", setup_s}, {"clock", "host steady_clock"}}},
+      {"warm_up", {{"steps", ran.warm_up.steps}, {"ms", ran.warm_up.ms}, {"clock", "host steady_clock"},
+                   {"what", "untimed steps from rest before the run, which then starts from rest"}}},
       {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * double(in.params.dt)},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"wall_ms", r.wall_ms}, {"wall_clock", "host steady_clock from the first step to the device's end "
@@ -154,7 +173,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
   return manifest;
 }
 
-void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r,
+void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r, const WarmUp& warm,
                    const Profiler& profiler, const StepMedians& med, const json& compare, const OutputDir& dir,
                    double setup_s) {
   const Model& m = in.model;
@@ -183,7 +202,11 @@ void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r,
               << " ms  (" << g.clock << ")\n";
   const json mem = memory_of(in);
   const double nodes = double(m.node_count());
-  std::cout << "  setup: model built in " << in.build_s << " s, pipeline in " << setup_s << " s (host clock)\n";
+  std::cout << "  setup: model built in " << in.build_s << " s, pipeline in " << setup_s << " s";
+  if (warm.steps > 0)
+    std::cout << "; warm-up: " << warm.steps << " untimed steps from rest in " << warm.ms / 1000.0
+              << " s, then back to rest";
+  std::cout << " (host clock)\n";
   std::cout << "  memory: host " << gib(mem["peak_resident_bytes"]) << " resident at peak; counted per node: model "
             << mem["model_host_bytes"].get<double>() / nodes << " B, pipeline "
             << mem["pipeline_host_bytes"].get<double>() / nodes << " B, state "
@@ -238,7 +261,7 @@ int run_command(const RunArgs& a) {
 #endif
     write_json(dir.staged("manifest.json"), manifest);
     dir.commit();
-    print_summary(a, in, r, profiler, med, compare, dir, setup_s);
+    print_summary(a, in, r, ran.warm_up, profiler, med, compare, dir, setup_s);
     return 0;
   });
 }

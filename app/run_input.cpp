@@ -86,6 +86,8 @@ void apply_param_flags(const RunArgs& a, Params& p) {
   if (a.check_every) p.check_every = *a.check_every;
   if (a.steps) p.max_steps = *a.steps;
   if (a.steps && *a.steps < 1) throw BadInput("--steps must be at least 1");
+  if (a.warmup_ms && !(*a.warmup_ms >= 0.0 && *a.warmup_ms <= 3.6e6))
+    throw BadInput("--warmup-ms must be between 0 and 3600000 (an hour)");
 }
 
 // Refuses a run whose host memory does not fit before anything is allocated.

@@ -1,6 +1,7 @@
 #include "pipeline.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +15,22 @@ std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
   }
   return t.take();
 }
+
+int warm_up(const std::function<void()>& step, const std::function<void()>& drain, int min_steps, double min_ms) {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  int done = 0;
+  // Batches double up to 256 steps between waits, so that a fast step is not timed by its waits.
+  for (int batch = 1; done < min_steps || std::chrono::duration<double, std::milli>(clock::now() - start).count() < min_ms;
+       batch = std::min(2 * batch, 256)) {
+    for (int k = 0; k < batch; ++k) step();
+    drain();
+    done += batch;
+  }
+  return done;
+}
+
+bool on_gpu(const PipelineEntry& e) { return e.traits.force != Engine::cpu || e.traits.update != Engine::cpu; }
 
 const char* to_string(Math m) { return m == Math::fast ? "fast" : "exact"; }
 

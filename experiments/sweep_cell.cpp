@@ -159,19 +159,26 @@ json stage_times(Pipeline& pipe, CellSteps& steps, const Sweep& s) {
   return stages;
 }
 
-std::string method_of(const Sweep& s) {
-  const std::string batches = ", median of " + std::to_string(s.repetitions) + " batches of " +
-                              std::to_string(s.steps) + " after " + std::to_string(s.warmup) + " warm-up steps";
+std::string method_of(const Sweep& s, double warm_ms) {
+  std::string batches = ", median of " + std::to_string(s.repetitions) + " batches of " + std::to_string(s.steps) +
+                        " after " + std::to_string(s.warmup) + " warm-up steps";
+  if (warm_ms > 0) batches += " (and before those at least " + std::to_string(int(warm_ms)) + " ms of untimed steps)";
   if (s.time == "frame")
     return "host steady_clock around each batch of frames (a step and a 1024 x 1024 draw each), from a drained "
            "device to a drained device, ms per frame" + batches;
   return "each step on its pipeline's step clock, ms per step (the batch's mean)" + batches;
 }
 
-// Times the cell on `pipe` from the rest state into `r`, or says why it was cut.
-json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
-  pipe.set_state(rest_state(m));
+// Times the cell on `pipe` from the rest state into `r`, or says why it was cut. Untimed steps
+// from rest for `warm_ms` (kGpuWarmUpMs on GPU pipelines) come first, as in `deformlab run`, so
+// that the steps that bound the cell and the timed ones run at the device's working clock.
+json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm_ms) {
   CellSteps steps(pipe, m, s.time);
+  if (warm_ms > 0) {
+    pipe.set_state(rest_state(m));
+    r["warm_up_steps"] = warm_up([&] { steps.step(); }, [&] { steps.finish(); }, 0, warm_ms);
+  }
+  pipe.set_state(rest_state(m));
   if (auto why = cut_after_second_step(steps, s); !why.empty()) return not_applicable(r, why);
   const std::unique_ptr<StepTimer> timer = s.time == "frame" ? nullptr : pipe.step_timer();
   const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s);
@@ -184,7 +191,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s) {
   r["stable"] = d == d;
   r["pipeline_timing"] = pipe.timing_method();
   r["time"] = s.time;
-  r["method"] = method_of(s);
+  r["method"] = method_of(s, warm_ms);
   if (timer) r["step_clock"] = timer->clock();
   return r;
 }
@@ -212,7 +219,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
       if (auto why = record_mesh(m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
-    return measure(r, *pipe, m, s);
+    return measure(r, *pipe, m, s, on_gpu(e) ? kGpuWarmUpMs : 0.0);
   } catch (const std::invalid_argument& ex) {
     return not_applicable(r, ex.what());
   } catch (const std::bad_alloc&) {

@@ -127,5 +127,31 @@ TEST(GlCommand, RunWritesFramesAndGlFacts) {
   std::filesystem::remove_all(dir);
 }
 
+// A GPU pipeline's run warms up (untimed steps from rest for 1000 ms by default) and then
+// starts again from rest: the final state is the one a run without the warm-up reaches.
+TEST(GlCommand, WarmsUpThenRunsFromRest) {
+  DEFORMLAB_REQUIRE_GL();
+  const auto dir = temp_dir("warm");
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const std::string args = "run -p glsl-compute --integrator verlet --grid 16x16 --steps 20 -o '";
+  const Command warm = run_deformlab("", args + (dir / "warm").string() + "'");
+  ASSERT_EQ(warm.exit_code, 0) << warm.output;
+  const Command cold = run_deformlab("", args + (dir / "cold").string() + "' --warmup-ms 0");
+  ASSERT_EQ(cold.exit_code, 0) << cold.output;
+  const std::string manifest = slurp(dir / "warm" / "manifest.json");
+  const auto at = manifest.find("\"warm_up\"");
+  ASSERT_NE(at, std::string::npos);
+  const auto ms = manifest.find("\"ms\":", at), steps = manifest.find("\"steps\":", at);
+  EXPECT_GE(std::stod(manifest.substr(ms + 5)), 1000.0) << manifest.substr(at, 200);
+  EXPECT_GT(std::stoi(manifest.substr(steps + 8)), 0) << manifest.substr(at, 200);
+  EXPECT_NE(warm.output.find("untimed steps from rest in"), std::string::npos) << warm.output;
+  EXPECT_EQ(cold.output.find("untimed steps"), std::string::npos) << cold.output;
+  EXPECT_EQ(slurp(dir / "warm" / "state.ply"), slurp(dir / "cold" / "state.ply")) << "the run starts from rest";
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace deformlab::test

@@ -35,6 +35,7 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_EQ(m["stages_timed_in"], "steps 1-8 of every 64");
   EXPECT_NE(r.out.find("passes timed in steps 1-8 of every 64"), std::string::npos) << r.out;
   EXPECT_EQ(m["scene"]["model"]["size"], nlohmann::json::array({8, 6}));
+  EXPECT_EQ(m["warm_up"]["steps"], 0) << "CPU pipelines start at once";
   EXPECT_LT(m["compare"]["max_position_error_relative_to_extent"].get<double>(), 1e-5);
   EXPECT_TRUE(m["build"].contains("compiler"));
   EXPECT_TRUE(m["machine"].contains("hardware_threads"));
