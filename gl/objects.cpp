@@ -1,5 +1,6 @@
 #include "objects.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,12 +14,13 @@ void delete_framebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
 void delete_renderbuffer(GLuint id) { glDeleteRenderbuffers(1, &id); }
 void delete_program(GLuint id) { glDeleteProgram(id); }
 
+// Immutable storage: no buffer is re-specified or mapped; the host writes with
+// glNamedBufferSubData, the GPU with its passes. Storage takes at least one byte.
 Buffer make_buffer(std::size_t bytes, const void* data) {
   GLuint id = 0;
-  glGenBuffers(1, &id);
-  glBindBuffer(GL_ARRAY_BUFFER, id);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), data, GL_DYNAMIC_COPY);
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  glCreateBuffers(1, &id);
+  glNamedBufferStorage(id, GLsizeiptr(std::max<std::size_t>(bytes, 1)), bytes > 0 ? data : nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
   Buffer b(id);
   check("allocating a buffer of " + std::to_string(bytes) + " bytes");
   return b;

@@ -44,7 +44,8 @@ using Framebuffer = Handle<delete_framebuffer>;
 using Renderbuffer = Handle<delete_renderbuffer>;
 using Program = Handle<delete_program>;
 
-// A buffer of `bytes` (data may be null), GL_DYNAMIC_COPY usage.
+// A buffer of `bytes` (data may be null): immutable storage the host writes with
+// glNamedBufferSubData.
 Buffer make_buffer(std::size_t bytes, const void* data = nullptr);
 // A texture-buffer view of `buffer` with the given texel format (GL_RGBA32F, GL_R32I, ...):
 // the whole buffer, or `bytes` from `offset` (a multiple of GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT).
