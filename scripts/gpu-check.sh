@@ -165,7 +165,8 @@ JSON
 fi
 
 # Node order on a mesh: a 1024 x 1024 triangulated sheet (1 M nodes, written as OBJ here)
-# in each order, 200 steps of the paper's drag scene on each GPU pipeline, the stop rule once.
+# in each order, 200 steps of the paper's drag scene on each GPU pipeline, the stop rule once;
+# cuda-fused and glsl-compute also without the warm-up.
 if part mesh; then
   python3 - "$out/sheet.obj" <<'PY'
 import sys
@@ -180,10 +181,14 @@ PY
 {"model": {"type": "mesh", "file": "sheet.obj", "order": "$order", "pins": [{"nearest": [-0.5, 1, -0.5]}, {"nearest": [0.5, 1, -0.5]}]},
  "drag": {"node": {"nearest": [0, 1, 0]}, "path": [[0, 0, 0, 0], [1, 0, 0.3, 0]]}}
 JSON
-    for p in cuda-fused cuda-naive cuda-tiled cuda-scatter glsl-compute; do
-      "$app" run --scene "$out/sheet-$order.json" --pipeline "$p" --steps 200 --check-every 100000 --no-state \
-        --out "/tmp/mesh-$order-$p" >"$out/mesh-$order-$p.log" 2>&1
+    # "-cold": without the run's warm-up (its first steps at the clock the GPU dropped to while
+    # the mesh loaded); timings.csv kept for those runs and their warm counterparts.
+    for p in cuda-fused cuda-naive cuda-tiled cuda-scatter glsl-compute cuda-fused-cold glsl-compute-cold; do
+      warm=(); [ "${p%-cold}" != "$p" ] && warm=(--warmup-ms 0)
+      "$app" run --scene "$out/sheet-$order.json" --pipeline "${p%-cold}" --steps 200 --check-every 100000 --no-state \
+        "${warm[@]}" --out "/tmp/mesh-$order-$p" >"$out/mesh-$order-$p.log" 2>&1
       cp "/tmp/mesh-$order-$p/manifest.json" "$out/mesh-$order-$p.json" 2>/dev/null
+      case $p in cuda-fused* | glsl-compute*) cp "/tmp/mesh-$order-$p/timings.csv" "$out/mesh-$order-$p.csv" ;; esac
       summary+=("mesh sheet 1M order $order $p: median $(median_of median_step_ms "$out/mesh-$order-$p.json") ms/step, bandwidth $(median_of bandwidth "$out/mesh-$order-$p.json")")
     done
   done
