@@ -159,10 +159,11 @@ json stage_times(Pipeline& pipe, CellSteps& steps, const Sweep& s) {
   return stages;
 }
 
-std::string method_of(const Sweep& s, double warm_ms) {
-  std::string batches = ", median of " + std::to_string(s.repetitions) + " batches of " + std::to_string(s.steps) +
-                        " after " + std::to_string(s.warmup) + " warm-up steps";
-  if (warm_ms > 0) batches += " (and before those at least " + std::to_string(int(warm_ms)) + " ms of untimed steps)";
+std::string method_of(const Sweep& s) {
+  const std::string batches = ", median of " + std::to_string(s.repetitions) + " batches of " +
+                              std::to_string(s.steps) + " after " + std::to_string(s.warmup) +
+                              " warm-up steps (pipelines with a GPU pass: after " +
+                              std::to_string(int(kGpuWarmUpMs)) + " ms of untimed steps from rest first)";
   if (s.time == "frame")
     return "host steady_clock around each batch of frames (a step and a 1024 x 1024 draw each), from a drained "
            "device to a drained device, ms per frame" + batches;
@@ -191,7 +192,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm
   r["stable"] = d == d;
   r["pipeline_timing"] = pipe.timing_method();
   r["time"] = s.time;
-  r["method"] = method_of(s, warm_ms);
+  r["method"] = method_of(s);
   if (timer) r["step_clock"] = timer->clock();
   return r;
 }
