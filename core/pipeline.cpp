@@ -19,10 +19,10 @@ std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
 int warm_up(const std::function<void()>& step, const std::function<void()>& drain, int min_steps, double min_ms) {
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
+  const auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(clock::now() - start).count(); };
   int done = 0;
-  // Batches double up to 256 steps between waits, so that a fast step is not timed by its waits.
-  for (int batch = 1; done < min_steps || std::chrono::duration<double, std::milli>(clock::now() - start).count() < min_ms;
-       batch = std::min(2 * batch, 256)) {
+  // Batches double up to 256 steps between waits, which keeps fast steps back to back on the device.
+  for (int batch = 1; done < min_steps || elapsed_ms() < min_ms; batch = std::min(2 * batch, 256)) {
     for (int k = 0; k < batch; ++k) step();
     drain();
     done += batch;
