@@ -35,11 +35,6 @@ double relative_position_error(const State& s, const State& ref) {
   return err / std::max(norm(hi - lo), 1e-12);
 }
 
-struct WarmUp {
-  int steps = 0;
-  double ms = 0.0;  // host clock
-};
-
 struct Ran {
   RunResult result;
   json frames;  // the frames' manifest with --frames, else null
@@ -51,9 +46,7 @@ WarmUp warm_up_from_rest(const RunArgs& a, const RunInput& in, Pipeline& pipe) {
   const double ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);
   if (ms <= 0.0) return {};
   pipe.set_state(rest_state(in.model));
-  const auto t0 = std::chrono::steady_clock::now();
-  const int steps = warm_up([&] { pipe.step(); }, [&] { pipe.max_displacement(); }, 1, ms);
-  return {steps, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()};
+  return warm_up([&] { pipe.step(); }, [&] { pipe.max_displacement(); }, ms);
 }
 
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,

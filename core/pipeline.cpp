@@ -16,18 +16,18 @@ std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
   return t.take();
 }
 
-int warm_up(const std::function<void()>& step, const std::function<void()>& drain, int min_steps, double min_ms) {
+WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& drain, double min_ms) {
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   const auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(clock::now() - start).count(); };
-  int done = 0;
+  WarmUp w;
   // Batches double up to 256 steps between waits, which keeps fast steps back to back on the device.
-  for (int batch = 1; done < min_steps || elapsed_ms() < min_ms; batch = std::min(2 * batch, 256)) {
+  for (int batch = 1; (w.ms = elapsed_ms()) < min_ms; batch = std::min(2 * batch, 256)) {
     for (int k = 0; k < batch; ++k) step();
     drain();
-    done += batch;
+    w.steps += batch;
   }
-  return done;
+  return w;
 }
 
 bool on_gpu(const PipelineEntry& e) { return e.traits.force != Engine::cpu || e.traits.update != Engine::cpu; }

@@ -136,11 +136,15 @@ std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, In
 // their ms in order.
 std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps);
 
-// Untimed steps (`step`, then `drain` waits for the device) until at least `min_steps` have
-// run and `min_ms` have passed on the host clock; returns the steps run. A GPU left idle (while
-// a model is built, say) lowers its clock and takes a few hundred ms of work to raise it again
-// (measured on the H100: 345 MHz to 1980), so GPU pipelines are timed after kGpuWarmUpMs of it.
-int warm_up(const std::function<void()>& step, const std::function<void()>& drain, int min_steps, double min_ms);
+// Untimed steps (`step`, then `drain` waits for the device) until `min_ms` have passed on the
+// host clock (none for 0): how many and how long. A GPU left idle (while a model is built, say)
+// lowers its clock and takes a few hundred ms of work to raise it again (measured on the H100:
+// 345 MHz to 1980), so GPU pipelines are timed after kGpuWarmUpMs of it.
+struct WarmUp {
+  int steps = 0;
+  double ms = 0.0;  // host clock
+};
+WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& drain, double min_ms);
 inline constexpr double kGpuWarmUpMs = 1000.0;
 // Whether any of e's passes runs on a GPU (it then warms up before it is timed).
 bool on_gpu(const PipelineEntry& e);

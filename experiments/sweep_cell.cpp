@@ -177,7 +177,8 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm
   CellSteps steps(pipe, m, s.time);
   if (warm_ms > 0) {
     pipe.set_state(rest_state(m));
-    r["warm_up_steps"] = warm_up([&] { steps.step(); }, [&] { steps.finish(); }, 0, warm_ms);
+    const WarmUp w = warm_up([&] { steps.step(); }, [&] { steps.finish(); }, warm_ms);
+    r["warm_up"] = {{"steps", w.steps}, {"ms", w.ms}, {"clock", "host steady_clock"}};
   }
   pipe.set_state(rest_state(m));
   if (auto why = cut_after_second_step(steps, s); !why.empty()) return not_applicable(r, why);
