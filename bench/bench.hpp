@@ -38,11 +38,13 @@ Stats stats(std::vector<double> ms);
 // `v` with `prec` decimals; "-" for NaN (not measured).
 std::string fixed(double v, int prec);
 
-// The flags every bench takes: grid sizes, scene, warm-up steps, integrator, CSV file.
+// The flags every bench takes: grid sizes, scene, warm-up steps, integrator, CSV file; the GPU
+// benches' untimed work before each case (add_warmup_ms).
 struct BenchOptions {
   std::vector<int> sizes;
   std::string scene = "paper";
   int warmup = 5;
+  double warmup_ms = kGpuWarmUpMs;
   std::string integrator = "semi-implicit-euler";
   std::string csv;  // also write the rows here when set
   // `integrator` parsed; throws std::invalid_argument naming it when unknown.
@@ -50,6 +52,13 @@ struct BenchOptions {
   SceneKind scene_kind() const { return parse_scene_kind(scene); }
 };
 void add_bench_options(CLI::App& c, BenchOptions& o);
+void add_warmup_ms(CLI::App& c, BenchOptions& o);
+
+// A GPU bench case's start: untimed steps of `p` from rest for o.warmup_ms (the device's clock
+// up after the host's setup, as `deformlab run` does), then `p` back at rest.
+void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o);
+// The method line's words for it, e.g. "1000 ms of untimed steps from rest, then ".
+std::string warm_up_words(const BenchOptions& o);
 
 // The CSV file at `path` with its header line written; not open when `path` is empty.
 // Throws std::invalid_argument when it cannot be written.
@@ -59,10 +68,11 @@ std::ofstream open_csv(const std::string& path, const char* header);
 struct StepOptions : BenchOptions {
   int reps = 0;
 };
-// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given);
-// `run` runs it.
+// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given; on a
+// GPU also --warmup-ms); `run` runs it.
+enum class Device { cpu, gpu };
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
-                    int reps, void (*run)(const StepOptions&));
+                    int reps, void (*run)(const StepOptions&), Device device);
 
 void add_cpu_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_CUDA

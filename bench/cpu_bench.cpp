@@ -41,7 +41,7 @@ void run_cpu(const StepOptions& o) {
 
 void add_cpu_bench(CLI::App& app) {
   add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 shape)", {64, 128, 256, 512},
-                 5, 30, run_cpu);
+                 5, 30, run_cpu, Device::cpu);
 }
 
 }  // namespace deformlab::bench

@@ -45,17 +45,17 @@ std::string fused_block(Math m) {
 
 double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
 
-// Median ms per step from the rest state: warm-up steps, then `batches` batches of steps
-// (each about a millisecond: 8 to 104 steps, a multiple of 8 so that cuda-temporal's launches
-// are whole), a batch's figure the mean of its steps, each step on the pipeline's step clock
-// (CUDA events).
-Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, int warmup, int batches) {
-  p.set_state(rest_state(m));
+// Median ms per step from the rest state: the warm-up (warm_up_from_rest, then o.warmup steps),
+// then o.batches batches of steps (each about a millisecond: 8 to 104 steps, a multiple of 8 so
+// that cuda-temporal's launches are whole), a batch's figure the mean of its steps, each step on
+// the pipeline's step clock (CUDA events).
+Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o) {
+  warm_up_from_rest(p, m, o);
   const auto timer = p.step_timer();
-  const double warm = mean(timed_steps(p, *timer, warmup));
+  const double warm = mean(timed_steps(p, *timer, o.warmup));
   const int steps = (std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100) + 7) / 8 * 8;
   std::vector<double> ms;
-  for (int b = 0; b < batches; ++b) ms.push_back(mean(timed_steps(p, *timer, steps)));
+  for (int b = 0; b < o.batches; ++b) ms.push_back(mean(timed_steps(p, *timer, steps)));
   return stats(ms);
 }
 
@@ -76,7 +76,7 @@ class Report {
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
     auto p = cuda::make_pipeline(scene.setup(integ), opt);
-    const Stats st = ms_per_step(*p, m, o.warmup, o.batches);
+    const Stats st = ms_per_step(*p, m, o);
     Row r;
     r.table = table;
     r.scene = to_string(kind);
@@ -111,7 +111,7 @@ class Report {
     r.math = "none";
     r.graphs = false;
     r.nodes = std::int64_t(n) * n;
-    r.ms = cuda::bare_gather_ms(n, tile, damped, verlet, o.batches);
+    r.ms = cuda::bare_gather_ms(n, tile, damped, verlet, o.batches, o.warmup_ms);
     r.floor_bytes = verlet ? 80 : 64;
     return record(r, 1);
   }
@@ -143,19 +143,21 @@ void run_cuda(const CudaOptions& o) {
 
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
-  const double copy = cuda::copy_ms(copy_bytes, 20);
+  const double copy = cuda::copy_ms(copy_bytes, 20, o.warmup_ms);
   const double copy_gbs = 2.0 * double(copy_bytes) / (copy * 1e-3) / 1e9;
   std::cout << "deformlab-bench cuda: " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
-            << "method: CUDA events around each step (the pipeline's step clock) after " << o.warmup
-            << " warm-up steps; batches of about 1 ms (3..100 steps) each giving its mean; median of " << o.batches
+            << "method: CUDA events around each step (the pipeline's step clock) after " << warm_up_words(o)
+            << o.warmup << " warm-up steps; batches of about 1 ms (3..100 steps) each giving its mean; median of "
+            << o.batches
             << " batches, in ms per step.\n"
             << "cloth grid n x n, 12 springs per interior node. " << describe(kind) << ";\n"
             << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
             << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
-            << "device of " << o.copy_mib << " MiB, " << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
+            << "device of " << o.copy_mib << " MiB (after " << fixed(o.warmup_ms, 0) << " ms of copies), "
+            << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);
@@ -212,7 +214,8 @@ void run_cuda(const CudaOptions& o) {
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each the median of " << o.batches
-              << " batches of 10 launches after 10 warm-up launches (CUDA events); a reference, not a bound "
+              << " batches of 10 launches after " << fixed(o.warmup_ms, 0)
+              << " ms of launches and 10 more (CUDA events); a reference, not a bound "
               << "(cuda-fused's L2 prefetch can beat it)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
@@ -287,6 +290,7 @@ void add_cuda_bench(CLI::App& app) {
   auto* c = app.add_subcommand("cuda", "CUDA variants: ms/step at 64^2 to 8192^2 against the copy bandwidth, "
                                        "step graphs, tile sweep");
   add_bench_options(*c, *o);
+  add_warmup_ms(*c, *o);
   c->add_option("--variants", o->variants, "Variants: naive, tiled, scatter, fused, temporal");
   c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");

@@ -28,7 +28,8 @@ void run_draw(const StepOptions& o) {
             << ", drawn 1280 x 800 as a surface.\n"
             << "frame: host clock from a drained device (the pipeline's last step done) to glFinish after the draw,\n"
             << "the state's hand-over included; draw: the draw alone on " << gl::Timer().method() << ".\n"
-            << "Medians of " << o.reps << " frames after " << o.warmup << " warm-up frames, ms.\n\n"
+            << "Medians of " << o.reps << " frames after " << warm_up_words(o) << o.warmup
+            << " warm-up frames, ms.\n\n"
             << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(22) << "route" << std::setw(11)
             << "frame ms" << std::setw(10) << "draw ms" << "\n";
   std::ofstream csv = open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms");
@@ -46,7 +47,7 @@ void run_draw(const StepOptions& o) {
         continue;
       }
       auto p = e.make(scene.setup(integ));
-      p->set_state(rest_state(scene.model));
+      warm_up_from_rest(*p, scene.model, o);
       p->step();
       std::unique_ptr<interop::GlPositions> bridge;
       if (route == Route::interop) bridge = std::make_unique<interop::GlPositions>(scene.model.node_count());
@@ -76,7 +77,7 @@ void run_draw(const StepOptions& o) {
 
 void add_draw_bench(CLI::App& app) {
   add_step_bench(app, "draw", "The viewer's frame: the state handed to the renderer and drawn, per route",
-                 {256, 1024, 2048}, 5, 30, run_draw);
+                 {256, 1024, 2048}, 5, 30, run_draw, Device::gpu);
 }
 
 }  // namespace deformlab::bench

@@ -19,7 +19,7 @@ namespace {
 
 // GPU ms per step of a GL pipeline, each step on its step clock after the warm-up.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
-  p.set_state(rest_state(m));
+  warm_up_from_rest(p, m, o);
   const auto timer = p.step_timer();
   timed_steps(p, *timer, o.warmup);
   const Stats s = stats(timed_steps(p, *timer, o.reps));
@@ -59,15 +59,20 @@ Stats time_passthrough(int n, const StepOptions& o) {
   Timer timer;
   glUseProgram(prog.id());
   glEnable(GL_RASTERIZER_DISCARD);
-  for (int k = 0; k < o.warmup + o.reps; ++k) {
-    if (k == o.warmup) timer.take();
-    const int c = k % 2;
-    timer.begin();
+  int k = 0;
+  const auto copy = [&] {
+    const int c = k++ % 2;
     glBindVertexArray(vao[c].id());
     glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, tfo[1 - c].id());
     glBeginTransformFeedback(GL_POINTS);
     glDrawArrays(GL_POINTS, 0, n);
     glEndTransformFeedback();
+  };
+  warm_up(copy, glFinish, o.warmup_ms);
+  for (int w = 0; w < o.warmup + o.reps; ++w) {
+    if (w == o.warmup) timer.take();
+    timer.begin();
+    copy();
     timer.end();
   }
   glDisable(GL_RASTERIZER_DISCARD);
@@ -92,17 +97,25 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   Timer timer;
   glUseProgram(prog.id());
   glUniform1i(0, n);
-  for (int k = 0; k < o.warmup + o.reps; ++k) {
-    if (k == o.warmup) timer.take();
-    const int c = k % 2;
+  int k = 0;
+  const auto bind = [&] {
+    const int c = k++ % 2;
     for (GLuint a = 0; a < 3; ++a) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, a, buf[c][a].id());
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a].id());
     }
-    timer.begin();
+  };
+  const auto dispatch = [&] {
     glDispatchCompute(GLuint((n + kComputeTileX - 1) / kComputeTileX), GLuint((n + kComputeTileY - 1) / kComputeTileY),
                       1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  };
+  warm_up([&] { bind(), dispatch(); }, glFinish, o.warmup_ms);
+  for (int w = 0; w < o.warmup + o.reps; ++w) {
+    if (w == o.warmup) timer.take();
+    bind();
+    timer.begin();
+    dispatch();
     timer.end();
   }
   glUseProgram(0);
@@ -118,7 +131,7 @@ void run_gl(const StepOptions& o) {
   std::cout << "deformlab-bench gl: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
-            << "method: " << gl::Timer().method() << " around each step, " << o.warmup
+            << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o) << o.warmup
             << " warm-up steps, median of " << o.reps << " timed steps\n"
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
                "the ceiling of the transform-feedback route\n"
@@ -171,7 +184,7 @@ void run_gl(const StepOptions& o) {
 
 void add_gl_bench(CLI::App& app) {
   add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling",
-                 {256, 512, 1024, 2048}, 10, 50, run_gl);
+                 {256, 512, 1024, 2048}, 10, 50, run_gl, Device::gpu);
 }
 
 }  // namespace deformlab::bench

@@ -80,8 +80,8 @@ void run_hybrid(const HybridOptions& o) {
   const int passes = info(integ).force_passes;
   const SceneKind kind = o.scene_kind();
   std::cout << "deformlab-bench hybrid: CUDA device " << dev << ", GL " << ctx.renderer << "\n"
-            << "cloth n x n, " << describe(kind) << "; " << o.integrator << ", " << o.warmup
-            << " warm-up steps, then " << o.steps << " timed steps.\n"
+            << "cloth n x n, " << describe(kind) << "; " << o.integrator << ", " << warm_up_words(o)
+            << o.warmup << " warm-up steps, then " << o.steps << " timed steps.\n"
             << "wall: host clock over the timed steps, drained at the end, per step. host: host clock inside step().\n"
             << "gpu: the pipeline's step clock, median per step of " << o.steps << " more steps (CUDA events for\n"
             << "cuda-fused; GL timer queries for glsl-tf and the hybrids, whose GL update waits for the CUDA\n"
@@ -116,7 +116,7 @@ void run_hybrid(const HybridOptions& o) {
     const PipelineSetup setup = scene.setup(integ);
     if (o.baselines) {
       auto p = cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true});
-      p->set_state(rest_state(m));
+      warm_up_from_rest(*p, m, o);
       for (int s = 0; s < o.warmup; ++s) p->step();
       Row r{n, "cuda-fused", "-"};
       std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
@@ -125,7 +125,7 @@ void run_hybrid(const HybridOptions& o) {
     }
     if (o.baselines) {
       auto p = gl::make_tf_pipeline(setup);
-      p->set_state(rest_state(m));
+      warm_up_from_rest(*p, m, o);
       for (int s = 0; s < o.warmup; ++s) p->step();
       Row r{n, "glsl-tf", "-"};
       Profiler prof;
@@ -148,7 +148,7 @@ void run_hybrid(const HybridOptions& o) {
         auto p = interop::make_hybrid_pipeline(
             setup, {u == "compute" ? interop::Update::compute : interop::Update::transform_feedback, *mode,
                     cuda::Variant::naive});
-        p->set_state(rest_state(m));
+        warm_up_from_rest(*p, m, o);
         for (int s = 0; s < o.warmup; ++s) p->step();
         Profiler prof;
         p->set_profiler(&prof);
@@ -173,6 +173,7 @@ void add_hybrid_bench(CLI::App& app) {
   auto* c = app.add_subcommand("hybrid", "Hybrid pipelines per interop mode, split by stage, against glsl-tf and "
                                          "cuda-fused");
   add_bench_options(*c, *o);
+  add_warmup_ms(*c, *o);
   c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
   c->add_option("--updates", o->updates, "Update passes: tf, compute");
   c->add_option("--steps", o->steps, "Timed steps")->check(CLI::PositiveNumber);

@@ -7,6 +7,7 @@
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
+#include "core/state.hpp"
 #include "experiments/experiment.hpp"
 #include "mesh/scene_model.hpp"
 
@@ -73,6 +74,20 @@ void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");
 }
 
+void add_warmup_ms(CLI::App& c, BenchOptions& o) {
+  c.add_option("--warmup-ms", o.warmup_ms, "Untimed steps from rest before each case for this long, ms (0: none)")
+      ->check(CLI::Range(0.0, 3.6e6));
+}
+
+void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o) {
+  warm_up([&] { p.step(); }, [&] { p.max_displacement(); }, o.warmup_ms);
+  p.set_state(rest_state(m));
+}
+
+std::string warm_up_words(const BenchOptions& o) {
+  return o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of untimed steps from rest (host clock), then " : "";
+}
+
 std::ofstream open_csv(const std::string& path, const char* header) {
   std::ofstream csv;
   if (path.empty()) return csv;
@@ -83,7 +98,7 @@ std::ofstream open_csv(const std::string& path, const char* header) {
 }
 
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
-                    int reps, void (*run)(const StepOptions&)) {
+                    int reps, void (*run)(const StepOptions&), Device device) {
   auto o = std::make_shared<StepOptions>();
   o->sizes = std::move(sizes);
   o->warmup = warmup;
@@ -91,6 +106,7 @@ void add_step_bench(CLI::App& app, const char* name, const char* description, st
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
   c->add_option("--reps", o->reps, "Timed steps")->check(CLI::PositiveNumber);
+  if (device == Device::gpu) add_warmup_ms(*c, *o);
   c->callback([o, run] { run(*o); });
 }
 

@@ -113,15 +113,16 @@ struct DeviceInfo {
 };
 DeviceInfo device_info();
 // Median GPU time of a device-to-device cudaMemcpy of `bytes`, ms (CUDA events, `reps` copies
-// after one warm-up).
-double copy_ms(std::int64_t bytes, int reps);
+// after copies for `warm_ms` (warm_up) and one more).
+double copy_ms(std::int64_t bytes, int reps, double warm_ms);
 // The bare gather: cuda-fused's loads and stores on an n x n cloth without its arithmetic
 // (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs); the
 // previous positions with `previous` (Verlet)), on blocks of `tile`: the fastest of three load
 // schedules (1, 2 or 4 neighbours' loads at a time), each the median over `batches` batches of
-// 10 launches after 10 warm-up launches, ms per launch (CUDA events). A reference for the
-// gather's memory traffic, not a bound: cuda-fused's L2 prefetch, which it lacks, can beat it.
-double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches);
+// 10 launches after launches for `warm_ms` (warm_up) and 10 more, ms per launch (CUDA events).
+// A reference for the gather's memory traffic, not a bound: cuda-fused's L2 prefetch, which it
+// lacks, can beat it.
+double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches, double warm_ms);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.
 double floor_bytes_per_node(const Model& m, Integrator i, const Options& o);

@@ -59,9 +59,11 @@ DeviceInfo device_info() {
 namespace {
 
 // The median over `batches` batches of `per_batch` calls of `work`, each batch timed by a pair
-// of CUDA events on the default stream after `warmup` calls: ms per call. `what` names the work.
+// of CUDA events on the default stream after calls for `warm_ms` (warm_up) and `warmup` calls
+// more: ms per call. `what` names the work.
 template <class Work>
-double median_event_ms(int warmup, int batches, int per_batch, Work&& work, const std::string& what) {
+double median_event_ms(double warm_ms, int warmup, int batches, int per_batch, Work&& work, const std::string& what) {
+  warm_up(work, [&] { check(cudaDeviceSynchronize(), ("warming up " + what).c_str()); }, warm_ms);
   for (int w = 0; w < warmup; ++w) work();
   check_launch(("starting " + what).c_str());
   cudaEvent_t e[2];
@@ -118,18 +120,18 @@ __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* _
 
 }  // namespace
 
-double copy_ms(std::int64_t bytes, int reps) {
+double copy_ms(std::int64_t bytes, int reps, double warm_ms) {
   require_device_memory(2 * bytes, "the copy benchmark");
   Buffer<char> a, b;
   a.allocate(std::size_t(bytes), "allocating the copy source");
   b.allocate(std::size_t(bytes), "allocating the copy destination");
   check(cudaMemset(a.get(), 1, std::size_t(bytes)), "filling the copy source");
-  return median_event_ms(1, reps, 1, [&] {
+  return median_event_ms(warm_ms, 1, reps, 1, [&] {
     check(cudaMemcpyAsync(b.get(), a.get(), std::size_t(bytes), cudaMemcpyDeviceToDevice), "copying device memory");
   }, "the copy");
 }
 
-double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches) {
+double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches, double warm_ms) {
   const std::int64_t nodes = std::int64_t(n) * n;
   require_device_memory((previous ? 5 : 4) * nodes * std::int64_t(sizeof(float4)), "the bare gather");
   Buffer<float4> x, v, xp, xo, vo;
@@ -151,7 +153,7 @@ double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batc
   double best = std::numeric_limits<double>::infinity();
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
                               pick(std::integral_constant<int, 4>{})})
-    best = std::min(best, median_event_ms(10, batches, 10, [&] {
+    best = std::min(best, median_event_ms(warm_ms, 10, batches, 10, [&] {
       kernel<<<blocks, threads>>>(n, x.get(), v.get(), xp.get(), xo.get(), vo.get());
     }, "the bare gather"));
   return best;

@@ -66,7 +66,8 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
       >"$out/sanitizer-$tool-cuda.log" 2>&1 &
     if [ -x "$bench" ]; then
       compute-sanitizer --tool "$tool" "$bench" cuda --sizes 64 --variants fused --tiles 16x8 --tile-size 64 \
-        --graph-sizes 64 --temporal-sizes 64 --steps-per-launch 1 --batches 3 >"$out/sanitizer-$tool-bench.log" 2>&1 &
+        --graph-sizes 64 --temporal-sizes 64 --steps-per-launch 1 --batches 3 --warmup-ms 0 \
+        >"$out/sanitizer-$tool-bench.log" 2>&1 &
     fi
     compute-sanitizer --tool "$tool" "$match_tests" \
       --gtest_filter='*/cuda_*cloth37x53*:*/cuda_fused_*cloth32_math_fast:*/cuda_fused_*contact37x53_math_fast:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*' \
