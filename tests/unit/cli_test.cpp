@@ -42,6 +42,15 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
 }
 
+// The summary's stages: a run that checks once has its reductions in one step, and says so.
+TEST_F(Cli, SummarySaysInHowManyStepsAStageRan) {
+  const Result r = run("run --pipeline cpu --grid 8x6 --steps 10 --check-every 1000 --no-state --out " +
+                       (dir_ / "run").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("(host clock; in 1 step)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("; in 10 steps"), std::string::npos) << r.out;
+}
+
 // A 4096x4096 cloth (16.8 M nodes) on cpu within memory: the model is its nodes (16 bytes
 // each), the whole run peaks near what the memory check counts (model, the pipeline's 6
 // vectors of floats, one state) and the final state streams into state.ply.
