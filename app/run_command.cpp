@@ -190,15 +190,13 @@ void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r, con
     std::cout << "  compare: largest position error vs the double reference: "
               << compare["max_position_error_relative_to_extent"].get<double>() << " of the model's extent\n";
   std::cout << "  where a step's time goes (median per step; passes timed in " << profiler.sampled_steps() << "):\n";
-  // A stage seen in fewer steps than the others (the checks of a run that checks rarely, whose
-  // last one waits for the queued steps) says in how many.
-  const std::vector<Profiler::Stage> stages = profiler.summary();
-  int most = 0;
-  for (const auto& g : stages) most = std::max(most, g.steps);
-  for (const auto& g : stages) {
+  // A stage seen in fewer steps than those sampled (the checks of a run that checks rarely, whose
+  // last one waits for the queued steps; cuda-temporal's launches) says in how many.
+  const int sampled = profiler.sampled_count(r.steps);
+  for (const auto& g : profiler.summary()) {
     std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
               << " ms  (" << g.clock;
-    if (g.steps < most) std::cout << "; in " << g.steps << (g.steps == 1 ? " step" : " steps");
+    if (g.steps < sampled) std::cout << "; in " << g.steps << (g.steps == 1 ? " step" : " steps");
     std::cout << ")\n";
   }
   const json mem = memory_of(in);

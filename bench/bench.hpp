@@ -57,7 +57,8 @@ void add_warmup_ms(CLI::App& c, BenchOptions& o);
 // A GPU bench case's start: untimed steps of `p` from rest for o.warmup_ms (the device's clock
 // up after the host's setup, as `deformlab run` does), then `p` back at rest.
 void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o);
-// The method line's words for it, e.g. "1000 ms of untimed steps from rest, then ".
+// The method line's words for it: "1000 ms of untimed steps from rest (host clock), then " (none
+// for 0).
 std::string warm_up_words(const BenchOptions& o);
 
 // The CSV file at `path` with its header line written; not open when `path` is empty.

@@ -10,7 +10,6 @@
 #include <numeric>
 
 #include "bench.hpp"
-#include "core/state.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
 
 namespace deformlab::bench {
@@ -156,8 +155,8 @@ void run_cuda(const CudaOptions& o) {
             << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
             << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
-            << "device of " << o.copy_mib << " MiB (after " << fixed(o.warmup_ms, 0) << " ms of copies), "
-            << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
+            << "device of " << o.copy_mib << " MiB"
+            << (o.warmup_ms > 0 ? " (after " + fixed(o.warmup_ms, 0) + " ms of copies)" : "") << ", " << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);
@@ -214,8 +213,9 @@ void run_cuda(const CudaOptions& o) {
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each the median of " << o.batches
-              << " batches of 10 launches after " << fixed(o.warmup_ms, 0)
-              << " ms of launches and 10 more (CUDA events); a reference, not a bound "
+              << " batches of 10 launches after "
+              << (o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of launches and " : "")
+              << "10 warm-up launches (CUDA events); a reference, not a bound "
               << "(cuda-fused's L2 prefetch can beat it)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";

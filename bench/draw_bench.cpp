@@ -7,7 +7,6 @@
 #include <iostream>
 
 #include "bench.hpp"
-#include "core/state.hpp"
 #include "experiments/pipelines.hpp"
 #include "gl/context.hpp"
 #include "gl/render.hpp"

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "bench.hpp"
-#include "core/state.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 
@@ -110,7 +109,12 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
                       1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   };
-  warm_up([&] { bind(), dispatch(); }, glFinish, o.warmup_ms);
+  warm_up(
+      [&] {
+        bind();
+        dispatch();
+      },
+      glFinish, o.warmup_ms);
   for (int w = 0; w < o.warmup + o.reps; ++w) {
     if (w == o.warmup) timer.take();
     bind();

@@ -7,7 +7,6 @@
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
-#include "core/state.hpp"
 #include "experiments/experiment.hpp"
 #include "mesh/scene_model.hpp"
 
@@ -80,8 +79,10 @@ void add_warmup_ms(CLI::App& c, BenchOptions& o) {
 }
 
 void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o) {
+  const State rest = rest_state(m);
+  p.set_state(rest);
   warm_up([&] { p.step(); }, [&] { p.max_displacement(); }, o.warmup_ms);
-  p.set_state(rest_state(m));
+  p.set_state(rest);
 }
 
 std::string warm_up_words(const BenchOptions& o) {

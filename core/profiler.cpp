@@ -26,6 +26,12 @@ std::string Profiler::sampled_steps() const {
   return "steps 1-" + std::to_string(kSampleWindow) + " of every " + std::to_string(every_ * kSampleWindow);
 }
 
+int Profiler::sampled_count(int n) const {
+  if (every_ <= 1) return n;
+  const int period = kSampleWindow * every_;
+  return n / period * kSampleWindow + std::min(n % period, kSampleWindow);
+}
+
 double Profiler::now_ms() const {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
 }

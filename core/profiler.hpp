@@ -54,6 +54,8 @@ class Profiler {
   bool sampled() const { return every_ <= 1 || step_ <= 0 || (step_ - 1) / kSampleWindow % every_ == 0; }
   // What the sampling covers, as a user reads it.
   std::string sampled_steps() const;
+  // How many of steps 1..n it samples.
+  int sampled_count(int n) const;
   void add(Span s);
   // The spans kept (all of them, unless streamed without keeping them).
   const std::vector<Span>& spans() const { return spans_; }

@@ -145,7 +145,8 @@ JSON
   [ -n "${BASE_APP:-}" ] && "$BASE_APP" experiment "$out/clock-check.json" --out "$out/results/clock-check-base" \
     >"$out/timing-experiment-base.log" 2>&1
   "$bench" cuda --sizes 2048 --variants fused naive --integrator explicit-euler --graph-sizes 64 --tile-size 2048 \
-    --tiles 16x8 --temporal-sizes 2048 --steps-per-launch 2 --csv "$out/timing-bench-cuda.csv" >"$out/timing-bench-cuda.txt" 2>&1
+    --tiles 16x8 --temporal-sizes 2048 --steps-per-launch 2 --csv "$out/timing-bench-cuda.csv" \
+    >"$out/timing-bench-cuda.txt" 2>&1
   "$bench" gl --sizes 2048 --integrator explicit-euler --csv "$out/timing-bench-gl.csv" >"$out/timing-bench-gl.txt" 2>&1
   for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
     "$app" run --experiment table2 --pipeline "$p" --grid 2048x2048 --steps 200 --check-every 100000 --no-state \
@@ -163,8 +164,8 @@ JSON
     for every in $first $steps; do
       walls=""
       for rep in 1 2 3; do
-        "$app" run --experiment table2 --pipeline "$p" "${opt[@]}" --grid 2048x2048 --steps $steps --check-every "$every" \
-          --no-state --out "/tmp/check-$rep" >"$out/timing-check-${pm/\//-}-$every-$rep.log" 2>&1
+        "$app" run --experiment table2 --pipeline "$p" "${opt[@]}" --grid 2048x2048 --steps "$steps" \
+          --check-every "$every" --no-state --out "/tmp/check-$rep" >"$out/timing-check-${pm/\//-}-$every-$rep.log" 2>&1
         walls+=" $(median_of wall_ms /tmp/check-$rep/manifest.json)"
         rm -rf "/tmp/check-$rep"
       done

@@ -1,6 +1,7 @@
 // The profiler's span model, summary and writers; and the run loop's spans.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -49,10 +50,14 @@ TEST(Profiler, SamplesWindowsOfStepsFromTheFirst) {
   }
   EXPECT_EQ(sampled, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 25, 26, 27, 28, 29, 30, 31, 32, 49, 50, 51, 52,
                                        53, 54, 55, 56}));
+  for (int n = 0; n <= 60; ++n)  // steps 1..n among those sampled
+    EXPECT_EQ(p.sampled_count(n), std::count_if(sampled.begin(), sampled.end(), [n](int s) { return s >= 1 && s <= n; }))
+        << n;
   EXPECT_EQ(sampling(nullptr), nullptr);
   p.sample_every(1);
   p.set_step(13);
   EXPECT_TRUE(p.sampled());
+  EXPECT_EQ(p.sampled_count(13), 13);
 }
 
 // Streamed spans: the file holds what write_csv writes, the summary is the same, and
