@@ -41,19 +41,15 @@ struct Ran {
   WarmUp warm_up;
 };
 
-// Untimed steps from rest for --warmup-ms (by default kGpuWarmUpMs where a pass runs on a GPU).
-WarmUp warm_up_from_rest(const RunArgs& a, const RunInput& in, Pipeline& pipe) {
-  const double ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);
-  if (ms <= 0.0) return {};
-  pipe.set_state(rest_state(in.model));
-  return warm_up([&] { pipe.step(); }, [&] { pipe.max_displacement(); }, ms);
-}
 
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
 // renders into the staged frames/ folder.
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {
-  const WarmUp warm = warm_up_from_rest(a, in, pipe);
-  pipe.set_state(rest_state(in.model));
+  // Untimed steps from rest for --warmup-ms (by default kGpuWarmUpMs where a pass runs on a GPU).
+  const double warm_ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);
+  WarmUp warm;
+  if (warm_ms > 0.0) warm = warm_up_from_rest(pipe, in.model, warm_ms);
+  else pipe.set_state(rest_state(in.model));
   RunOptions opt;
   opt.until_converged = in.until_converged;
   opt.integrator = in.integ;

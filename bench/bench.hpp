@@ -54,9 +54,8 @@ struct BenchOptions {
 void add_bench_options(CLI::App& c, BenchOptions& o);
 void add_warmup_ms(CLI::App& c, BenchOptions& o);
 
-// A GPU bench case's start: untimed steps of `p` from rest for o.warmup_ms (the device's clock
-// up after the host's setup, as `deformlab run` does), then `p` back at rest.
-void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o);
+// A GPU bench case starts with warm_up_from_rest(p, m, o.warmup_ms): the device's clock up after
+// the host's setup, as `deformlab run` does.
 // The method line's words for it: "1000 ms of untimed steps from rest (host clock), then " (none
 // for 0).
 std::string warm_up_words(const BenchOptions& o);

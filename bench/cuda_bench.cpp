@@ -49,7 +49,7 @@ double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.
 // that cuda-temporal's launches are whole), a batch's figure the mean of its steps, each step on
 // the pipeline's step clock (CUDA events).
 Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o) {
-  warm_up_from_rest(p, m, o);
+  warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
   const double warm = mean(timed_steps(p, *timer, o.warmup));
   const int steps = (std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100) + 7) / 8 * 8;
@@ -156,7 +156,8 @@ void run_cuda(const CudaOptions& o) {
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
             << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
             << "device of " << o.copy_mib << " MiB"
-            << (o.warmup_ms > 0 ? " (after " + fixed(o.warmup_ms, 0) + " ms of copies)" : "") << ", " << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
+            << (o.warmup_ms > 0 ? " (after " + fixed(o.warmup_ms, 0) + " ms of copies)" : "") << ", "
+            << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs);

@@ -46,7 +46,7 @@ void run_draw(const StepOptions& o) {
         continue;
       }
       auto p = e.make(scene.setup(integ));
-      warm_up_from_rest(*p, scene.model, o);
+      warm_up_from_rest(*p, scene.model, o.warmup_ms);
       p->step();
       std::unique_ptr<interop::GlPositions> bridge;
       if (route == Route::interop) bridge = std::make_unique<interop::GlPositions>(scene.model.node_count());

@@ -18,7 +18,7 @@ namespace {
 
 // GPU ms per step of a GL pipeline, each step on its step clock after the warm-up.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
-  warm_up_from_rest(p, m, o);
+  warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
   timed_steps(p, *timer, o.warmup);
   const Stats s = stats(timed_steps(p, *timer, o.reps));

@@ -119,7 +119,7 @@ void run_hybrid(const HybridOptions& o) {
     const PipelineSetup setup = scene.setup(integ);
     if (o.baselines) {
       auto p = cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true});
-      warm_up_from_rest(*p, m, o);
+      warm_up_from_rest(*p, m, o.warmup_ms);
       for (int s = 0; s < o.warmup; ++s) p->step();
       Row r{n, "cuda-fused", "-"};
       std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
@@ -128,7 +128,7 @@ void run_hybrid(const HybridOptions& o) {
     }
     if (o.baselines) {
       auto p = gl::make_tf_pipeline(setup);
-      warm_up_from_rest(*p, m, o);
+      warm_up_from_rest(*p, m, o.warmup_ms);
       for (int s = 0; s < o.warmup; ++s) p->step();
       Row r{n, "glsl-tf", "-"};
       Profiler prof;
@@ -151,7 +151,7 @@ void run_hybrid(const HybridOptions& o) {
         auto p = interop::make_hybrid_pipeline(
             setup, {u == "compute" ? interop::Update::compute : interop::Update::transform_feedback, *mode,
                     cuda::Variant::naive});
-        warm_up_from_rest(*p, m, o);
+        warm_up_from_rest(*p, m, o.warmup_ms);
         for (int s = 0; s < o.warmup; ++s) p->step();
         Profiler prof;
         p->set_profiler(&prof);

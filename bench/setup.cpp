@@ -78,13 +78,6 @@ void add_warmup_ms(CLI::App& c, BenchOptions& o) {
       ->check(CLI::Range(0.0, 3.6e6));
 }
 
-void warm_up_from_rest(Pipeline& p, const Model& m, const BenchOptions& o) {
-  const State rest = rest_state(m);
-  p.set_state(rest);
-  warm_up([&] { p.step(); }, [&] { p.max_displacement(); }, o.warmup_ms);
-  p.set_state(rest);
-}
-
 std::string warm_up_words(const BenchOptions& o) {
   return o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of untimed steps from rest (host clock), then " : "";
 }

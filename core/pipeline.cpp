@@ -30,6 +30,14 @@ WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& d
   return w;
 }
 
+WarmUp warm_up_from_rest(Pipeline& p, const Model& m, double min_ms) {
+  const State rest = rest_state(m);
+  p.set_state(rest);
+  const WarmUp w = warm_up([&] { p.step(); }, [&] { p.max_displacement(); }, min_ms);
+  p.set_state(rest);
+  return w;
+}
+
 bool on_gpu(const PipelineEntry& e) { return e.traits.force != Engine::cpu || e.traits.update != Engine::cpu; }
 
 const char* to_string(Math m) { return m == Math::fast ? "fast" : "exact"; }

@@ -145,6 +145,8 @@ struct WarmUp {
   double ms = 0.0;  // host clock
 };
 WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& drain, double min_ms);
+// warm_up of `p`'s steps (drained by max_displacement) from m's rest state, then `p` back at rest.
+WarmUp warm_up_from_rest(Pipeline& p, const Model& m, double min_ms);
 inline constexpr double kGpuWarmUpMs = 1000.0;
 // Whether any of e's passes runs on a GPU (it then warms up before it is timed).
 bool on_gpu(const PipelineEntry& e);
