@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -21,11 +22,14 @@ WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& d
   const auto start = clock::now();
   const auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(clock::now() - start).count(); };
   WarmUp w;
-  // Batches double up to 256 steps between waits, which keeps fast steps back to back on the device.
-  for (int batch = 1; (w.ms = elapsed_ms()) < min_ms; batch = std::min(2 * batch, 256)) {
+  // Batches double up to 256 steps between waits, which keeps fast steps back to back on the device, but take
+  // no more steps than the time left needs at the mean step so far: the warm-up ends within about a step of min_ms.
+  for (int batch = 1; (w.ms = elapsed_ms()) < min_ms;) {
     for (int k = 0; k < batch; ++k) step();
     drain();
     w.steps += batch;
+    const double now = elapsed_ms();
+    batch = std::clamp(int(std::ceil((min_ms - now) * w.steps / now)), 1, std::min(2 * batch, 256));
   }
   return w;
 }

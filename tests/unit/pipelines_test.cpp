@@ -1,6 +1,9 @@
 // The registry's traits: every pipeline name carries the same traits and options in every
-// build, whether its backend is built or stands in as unavailable.
+// build, whether its backend is built or stands in as unavailable; the untimed warm-up.
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
 
 #include "experiments/pipelines.hpp"
 
@@ -30,6 +33,18 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
 
 // Option names and values are read before anything runs: a name the pipeline does not read,
 // and every value a backend built here cannot read, are refused with the pipeline's name.
+TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
+  // 4 ms steps for 140 ms: batches doubling without a bound would stop after 1 + 2 + ... + 32 = 63 steps
+  // (252 ms); at the mean step the warm-up takes about 35.
+  int steps = 0, drains = 0;
+  const WarmUp w = warm_up([&] { ++steps, std::this_thread::sleep_for(std::chrono::milliseconds(4)); },
+                           [&] { ++drains; }, 140);
+  EXPECT_EQ(w.steps, steps);
+  EXPECT_GE(w.ms, 140);
+  EXPECT_LT(w.ms, 180) << "in " << w.steps << " steps";
+  EXPECT_GE(drains, 6) << "the batches still start at one step and double";
+}
+
 TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
   const PipelineRegistry& r = pipelines();
   const auto refusal = [&](const char* pipeline, const PipelineOptions& o) {
