@@ -1,6 +1,7 @@
 #include "report.hpp"
 
 #include <algorithm>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -63,6 +64,15 @@ void write_setup(Report& r) {
        << " hardware threads, " << m.value("os", std::string("?")) << "\n";
   r.md << "- Build: deformlab " << build.value("deformlab", std::string()) << " (" << build.value("git", std::string())
        << "), " << build.value("compiler", std::string()) << ", CUDA " << build.value("cuda", std::string()) << "\n";
+  // A resumed sweep may hold cells of several builds; the manifest names the last run's.
+  std::map<std::string, int> builds;
+  for (const auto& c : r.cells)
+    if (c["status"] == "ok") ++builds[c.value("build", std::string("not recorded"))];
+  if (builds.size() > 1 || (builds.size() == 1 && builds.begin()->first != build.value("git", std::string()))) {
+    r.md << "- Measured cells by build:";
+    for (const auto& [git, n] : builds) r.md << (git == builds.begin()->first ? " " : ", ") << git << " (" << n << ")";
+    r.md << "\n";
+  }
   const json calibration = r.manifest.value("calibration", json());
   if (r.ceil.any()) {
     r.md << "- Calibration (`deformlab calibrate`, "

@@ -202,7 +202,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm
 
 json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache) {
   json r = {{"id", c.id()}, {"size", c.size}, {"pipeline", c.pipeline}, {"integrator", c.integrator},
-            {"options", c.options}};
+            {"options", c.options}, {"build", build_info()["git"]}};
   if (!c.model.empty()) r["model"] = c.model;
   if (!c.order.empty()) r["order"] = c.order;
   const PipelineEntry& e = *pipelines().find(c.pipeline);

@@ -222,6 +222,7 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
   auto cell = [&](const std::string& p, int n, double ms) {
     json c = {{"id", p + std::to_string(n)}, {"size", n}, {"pipeline", p}, {"integrator", "explicit-euler"},
               {"options", json::object()}, {"nodes", n * n}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"},
+              {"build", "g"},
               {"step_clock", p == "omp" ? "host clock" : "GL timer queries (GL_TIMESTAMP)"}};
     std::ofstream(dir_ / "cells" / (p + std::to_string(n) + ".json")) << c.dump();
   };
@@ -253,6 +254,7 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
       << md;
   EXPECT_NE(md.find("[2] cut: too slow (glsl-tf 512²)"), std::string::npos) << md;
   EXPECT_NE(md.find("- Method: fixed. "), std::string::npos) << md;
+  EXPECT_EQ(md.find("cells by build"), std::string::npos) << "every cell of the manifest's build" << md;
   const std::size_t clocks = md.find("- Step clocks: ");
   ASSERT_NE(clocks, std::string::npos) << md;
   const std::string line = md.substr(clocks, md.find('\n', clocks) - clocks);
@@ -291,6 +293,7 @@ TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
   auto cell = [&](const std::string& p, const json& options, double ms, const json& stages) {
     json c = {{"id", p}, {"size", 64}, {"pipeline", p}, {"integrator", "semi-implicit-euler"}, {"options", options},
               {"nodes", 4096}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"}, {"stages", stages}};
+    if (p == "cuda-fused") c["build"] = "h";  // resumed by another build than the hybrid's, whose cell names none
     std::ofstream(dir_ / "cells" / (p + ".json")) << c.dump();
   };
   cell("cuda-fused", json::object(), 0.01,
@@ -302,6 +305,7 @@ TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
 
   std::string md = slurp(write_report(dir_));
   EXPECT_NE(md.find("No calibration recorded"), std::string::npos) << md;
+  EXPECT_NE(md.find("- Measured cells by build: h (1), not recorded (1)\n"), std::string::npos) << md;
   EXPECT_EQ(md.find("Against this device's ceilings"), std::string::npos) << md;
 
   manifest["calibration"] = calibration;
