@@ -16,7 +16,7 @@
 # together passed 10 minutes, so run them as separate commands where one is limited to that.
 # On b1c55d7 (its bench warming each case up for a second) timing ran past 9.5 minutes: its bench
 # spent 3.6 of them on 8192^2 cuda-temporal cases, now left out, and glsl-tf's check runs 4.4 on
-# 2000 steps each, now 200.
+# 2000 steps each, now 200: on dbe6930 it took 3.5 minutes, and the tests part (JOBS=8) 5.3.
 # The build folder can travel as .dev/*.tar.xz (scripts/pack-for-device.sh: the tree and its
 # programs), unpacked here.
 set -uo pipefail
