@@ -57,9 +57,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
 #if DEFORMLAB_GL_RENDER
   std::optional<gl::FrameWriter> frames;
   if (a.frames) {
-    gl::RenderOptions look;
-    look.ground = in.params.ground;
-    frames.emplace(in.model, dir.staged("frames"), *a.frames, look);
+    frames.emplace(in.model, dir.staged("frames"), *a.frames, gl::with_obstacles({}, in.params));
     opt.after_step = [&](int step) {
       HostSpan span(&profiler, span::render);
       frames->after_step(pipe, step);

@@ -174,9 +174,7 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
     auto pipe = e.make({m, p, integ, {}});
     pipe->set_state(rest_state(m));
     fs::remove_all(tmp);
-    gl::RenderOptions look{512, 512};
-    look.ground = p.ground;
-    gl::FrameWriter frames(m, tmp, every, look);
+    gl::FrameWriter frames(m, tmp, every, gl::with_obstacles({512, 512}, p));
     RunOptions opt;
     opt.integrator = integ;
     opt.after_step = [&](int step) { frames.after_step(*pipe, step); };

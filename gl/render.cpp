@@ -17,6 +17,8 @@ namespace {
 
 using Mat4 = std::array<float, 16>;  // column-major
 
+constexpr int kSphereSlices = 48, kSphereStacks = 24;  // quads a sphere is drawn with
+
 Mat4 mul(const Mat4& a, const Mat4& b) {
   Mat4 r{};
   for (int c = 0; c < 4; ++c)
@@ -115,10 +117,19 @@ struct Renderer::Impl {
   bool have_prev = false;
   GLint texels = 0, align = 16;
   Timer timer;
+  Program obstacle_prog;  // made where there are obstacles
+  Vec3f ground_centre;    // the ground's square: under the first camera's target, 1.5 x its
+  float ground_half = 0;  // distance from the eye to each side
 
   Impl(const Model& model, RenderOptions opt) : m(model), o(opt), camera(framing(model, opt.ground)) {
     make_framebuffer();
     prog = make_program({{GL_VERTEX_SHADER, "render.vert"}, {GL_FRAGMENT_SHADER, "render.frag"}});
+    if (o.ground || !o.spheres.empty())
+      obstacle_prog = make_program({{GL_VERTEX_SHADER, "obstacle.vert"}, {GL_FRAGMENT_SHADER, "obstacle.frag"}});
+    if (o.ground) {
+      ground_centre = {camera.target.x, *o.ground, camera.target.z};
+      ground_half = 1.5f * norm(camera.eye - camera.target);
+    }
     GLuint id = 0;
     glGenVertexArrays(1, &id);
     vao = VertexArray(id);
@@ -251,10 +262,11 @@ struct Renderer::Impl {
         glDrawArrays(GL_POINTS, 0, b.count);
       }
     }
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    draw_obstacles(vp);
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
-    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     if (colour == Colour::speed) {  // these positions are the next draw's previous ones
       glCopyNamedBufferSubData(positions, prev.id(), 0, 0, GLsizeiptr(m.node_count()) * 16);
       prev_time = time;
@@ -263,6 +275,35 @@ struct Renderer::Impl {
     timer.end();
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
     check("rendering a frame");
+  }
+
+  // After the model, depth-tested without writing depth: the model hides them, and surface_at
+  // finds only the model. A sphere culls its back faces (convex: each pixel gets its front); one
+  // below the ground shows through it.
+  void draw_obstacles(const Mat4& vp) {
+    if (!obstacle_prog) return;
+    const GLuint id = obstacle_prog.id();
+    glUseProgram(id);
+    glUniformMatrix4fv(uniform(id, "u_view_proj"), 1, GL_FALSE, vp.data());
+    glUniform3f(uniform(id, "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
+    glDepthMask(GL_FALSE);
+    if (o.ground) {
+      glUniform1i(uniform(id, "u_kind"), 0);
+      glUniform3f(uniform(id, "u_center"), ground_centre.x, ground_centre.y, ground_centre.z);
+      glUniform1f(uniform(id, "u_size"), ground_half);
+      glUniform1f(uniform(id, "u_check"), ground_half / 10);
+      glDrawArrays(GL_TRIANGLES, 0, 6);
+    }
+    glEnable(GL_CULL_FACE);
+    glUniform1i(uniform(id, "u_kind"), 1);
+    glUniform2i(uniform(id, "u_grid"), kSphereSlices, kSphereStacks);
+    for (const Sphere& sphere : o.spheres) {
+      glUniform3f(uniform(id, "u_center"), sphere.center.x, sphere.center.y, sphere.center.z);
+      glUniform1f(uniform(id, "u_size"), sphere.radius);
+      glDrawArrays(GL_TRIANGLES, 0, 6 * kSphereSlices * kSphereStacks);
+    }
+    glDisable(GL_CULL_FACE);
+    glDepthMask(GL_TRUE);
   }
 
   // The rest positions, the previous positions and a mesh's triangles as texture buffers on
@@ -292,6 +333,12 @@ struct Renderer::Impl {
     return Texture(id);
   }
 };
+
+RenderOptions with_obstacles(RenderOptions o, const Params& p) {
+  o.ground = p.ground;
+  o.spheres = p.spheres;
+  return o;
+}
 
 Renderer::Renderer(const Model& m, RenderOptions o) {
   context();

@@ -1,5 +1,6 @@
 // Drawing a state into an offscreen framebuffer (points, or a lit surface: a cloth grid's with
-// normals from its neighbours, a mesh's triangles with flat normals, all computed on the GPU), PNG frames and an MP4 through ffmpeg when it is installed.
+// normals from its neighbours, a mesh's triangles with flat normals, all computed on the GPU)
+// with the scene's ground and spheres, PNG frames and an MP4 through ffmpeg when it is installed.
 // Works for every pipeline: GL pipelines are drawn from their own buffers, others uploaded.
 #pragma once
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "core/params.hpp"
 #include "core/pipeline.hpp"
 #include "core/state.hpp"
 
@@ -27,9 +29,14 @@ struct RenderOptions {
   // stride-th row and column.
   std::int64_t band_texels = 0;
   // The scene's ground height: the camera frames down to it and half the model's width to each
-  // side (a model dropped onto it stays in view).
+  // side (a model dropped onto it stays in view). The ground and the spheres are drawn where
+  // the model does not hide them, and left out of surface_at's picking.
   std::optional<float> ground;
+  std::vector<Sphere> spheres;
 };
+
+// `o` with the scene's obstacles (its ground and spheres).
+RenderOptions with_obstacles(RenderOptions o, const Params& p);
 
 // A perspective camera: where it is, what it looks at, its up direction and vertical field of
 // view (radians).

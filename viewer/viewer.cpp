@@ -34,7 +34,7 @@ nlohmann::json to_json(Vec3f v) { return {v.x, v.y, v.z}; }
 class Viewer {
  public:
   Viewer(Window& w, Session& s, const ViewOptions& o)
-      : w_(w), s_(s), o_(o), r_(s.model(), {.width = view_width(), .height = std::max(w.height(), 1), .ground = o.ground}),
+      : w_(w), s_(s), o_(o), r_(s.model(), gl::with_obstacles({.width = view_width(), .height = std::max(w.height(), 1)}, s.params())),
         home_(r_.camera()), start_(s.pipeline().state()), script_(o.script) {
     if (!o_.record.empty()) rec_ = std::make_unique<Recorder>(o_.record, w_.width(), w_.height(), kVideoFps);
     summary_["recordings"] = nlohmann::json::array();

@@ -1,7 +1,6 @@
 // `deformlab view`: the simulation in a window, stepped continuously, poked with the mouse,
 // its stages switched and timed live from a panel.
 #pragma once
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,7 +19,6 @@ struct ViewOptions {
   double seconds = 0.0;     // with `record`: this many seconds of video (30 frames a second), then quit
   int frames = 0;           // quit after this many frames (0: when the window closes)
   std::string summary;      // a JSON summary of the session written at the end
-  std::optional<float> ground;  // the scene's ground, for the first camera
 };
 
 // Runs the viewer until the window closes or an option or the script ends it; returns the

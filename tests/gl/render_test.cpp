@@ -154,6 +154,60 @@ TEST(GlRender, ColoursByStrainAndSpeed) {
   }
 }
 
+// The scene's ground and spheres are drawn where the model does not hide them: a sphere beside
+// the cloth shows blue-grey, one behind it stays hidden, the ground shows grey where there was
+// background, every pixel of the cloth is what it is without obstacles, and picking
+// (surface_at) finds the cloth but no point on an obstacle.
+TEST(GlRender, GroundAndSpheresWhereTheModelDoesNotHideThem) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(16, 16);  // horizontal, 0.75 m wide, at y = 1
+  const int w = 256, h = 256;
+  const float ground_y = 0.6f;
+  const gl::Camera cam = gl::framing(m, ground_y);
+  const Vec3f centre = {0.f, 1.f, 0.f}, beside = {0.6f, 1.f, 0.f};  // the cloth's centre; right of its edge
+  const Vec3f behind = centre + (centre - cam.eye) * (0.5f / norm(centre - cam.eye));
+  gl::RenderOptions look{w, h};
+  look.ground = ground_y;
+  look.spheres = {{beside, 0.08f}, {behind, 0.03f}};
+  gl::Renderer r(m, look), alone(m, {w, h});
+  alone.set_camera(cam);
+  alone.draw(rest_state(m));
+  const auto before = alone.pixels();
+  r.draw(rest_state(m));
+  const auto px = r.pixels();
+  auto at = [&](const std::vector<std::uint8_t>& img, int x, int y) { return &img[(std::size_t(y) * w + x) * 4]; };
+  const std::uint8_t* bg = at(before, 0, 0);
+  auto is_bg = [&](const std::uint8_t* p) { return p[0] == bg[0] && p[1] == bg[1] && p[2] == bg[2]; };
+
+  long cloth = 0, changed = 0, ground = 0;
+  std::array<int, 2> ground_px{-1, -1};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::uint8_t *a = at(before, x, y), *b = at(px, x, y);
+      if (!is_bg(a)) {
+        ++cloth;
+        changed += a[0] != b[0] || a[1] != b[1] || a[2] != b[2];
+      } else if (!is_bg(b) && std::abs(int(b[0]) - int(b[2])) <= 12) {
+        ++ground;
+        if (ground_px[0] < 0 && y > h / 2) ground_px = {x, y};
+      }
+    }
+  EXPECT_GT(cloth, 1000);
+  EXPECT_EQ(changed, 0) << "of " << cloth << " cloth pixels: the ground or the hidden sphere drawn over the cloth";
+  EXPECT_GT(ground, w * h / 10) << "the ground's grey over the background";
+  const auto [sx, sy] = cam.pixel(beside, w, h);
+  ASSERT_TRUE(sx > 0 && sx < w && sy > 0 && sy < h) << "the sphere beside the cloth is in view";
+  const std::uint8_t* sphere = at(px, int(sx), int(sy));
+  EXPECT_GT(int(sphere[2]), int(sphere[0]) + 20) << "blue-grey: " << int(sphere[0]) << " " << int(sphere[2]);
+  EXPECT_FALSE(r.surface_at(sx, sy)) << "a sphere is not picked";
+  ASSERT_GE(ground_px[0], 0);
+  EXPECT_FALSE(r.surface_at(ground_px[0] + 0.5, ground_px[1] + 0.5)) << "the ground is not picked";
+  const auto [cx, cy] = cam.pixel(centre, w, h);
+  const auto picked = r.surface_at(cx, cy);
+  ASSERT_TRUE(picked) << "the cloth is picked";
+  EXPECT_NEAR(picked->y, 1.f, 0.01f);
+}
+
 TEST(GlRender, LatticeAsPointsAndPngFile) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_lattice(6, 5, 4);
