@@ -41,7 +41,6 @@ struct Ran {
   WarmUp warm_up;
 };
 
-
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
 // renders into the staged frames/ folder.
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {

@@ -28,8 +28,8 @@ WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& d
     for (int k = 0; k < batch; ++k) step();
     drain();
     w.steps += batch;
-    const double now = elapsed_ms();
-    batch = std::clamp(int(std::ceil((min_ms - now) * w.steps / now)), 1, std::min(2 * batch, 256));
+    const double now = elapsed_ms(), needed = std::ceil((min_ms - now) * w.steps / std::max(now, 1e-6));
+    batch = int(std::clamp(needed, 1.0, double(std::min(2 * batch, 256))));
   }
   return w;
 }

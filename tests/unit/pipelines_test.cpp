@@ -31,8 +31,6 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_THROW(math_option({{"math", "quick"}}), std::invalid_argument);
 }
 
-// Option names and values are read before anything runs: a name the pipeline does not read,
-// and every value a backend built here cannot read, are refused with the pipeline's name.
 TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
   // 4 ms steps for 140 ms: batches doubling without a bound would stop after 1 + 2 + ... + 32 = 63 steps
   // (252 ms); at the mean step the warm-up takes about 35.
@@ -45,6 +43,8 @@ TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
   EXPECT_GE(drains, 6) << "the batches still start at one step and double";
 }
 
+// Option names and values are read before anything runs: a name the pipeline does not read,
+// and every value a backend built here cannot read, are refused with the pipeline's name.
 TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
   const PipelineRegistry& r = pipelines();
   const auto refusal = [&](const char* pipeline, const PipelineOptions& o) {
