@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <numeric>
 #include <thread>
+#include <vector>
 
 #include "experiments/pipelines.hpp"
 
@@ -34,13 +36,16 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
 TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
   // 4 ms steps for 140 ms: batches doubling without a bound would stop after 1 + 2 + ... + 32 = 63 steps
   // (252 ms); at the mean step the warm-up takes about 35.
-  int steps = 0, drains = 0;
+  int steps = 0;
+  std::vector<int> batches;  // steps between drains
   const WarmUp w = warm_up([&] { ++steps, std::this_thread::sleep_for(std::chrono::milliseconds(4)); },
-                           [&] { ++drains; }, 140);
+                           [&] { batches.push_back(steps - std::accumulate(batches.begin(), batches.end(), 0)); }, 140);
   EXPECT_EQ(w.steps, steps);
   EXPECT_GE(w.ms, 140);
   EXPECT_LT(w.ms, 180) << "in " << w.steps << " steps";
-  EXPECT_GE(drains, 6) << "the batches still start at one step and double";
+  // The first 15 steps take 60 ms: the batches still start at one step and double.
+  ASSERT_GE(batches.size(), 4u);
+  EXPECT_EQ(std::vector<int>(batches.begin(), batches.begin() + 4), (std::vector<int>{1, 2, 4, 8}));
 }
 
 // Option names and values are read before anything runs: a name the pipeline does not read,
