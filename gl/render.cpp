@@ -278,8 +278,8 @@ struct Renderer::Impl {
   }
 
   // After the model, depth-tested without writing depth: the model hides them, and surface_at
-  // finds only the model. A sphere culls its back faces (convex: each pixel gets its front); one
-  // below the ground shows through it.
+  // finds only the model. A sphere culls its back faces (convex: each pixel gets its front) and
+  // drops what lies on the other side of the ground from the eye (obstacle.frag).
   void draw_obstacles(const Mat4& vp) {
     if (!obstacle_prog) return;
     const GLuint id = obstacle_prog.id();
@@ -287,6 +287,8 @@ struct Renderer::Impl {
     glUniformMatrix4fv(uniform(id, "u_view_proj"), 1, GL_FALSE, vp.data());
     glUniform3f(uniform(id, "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
     glDepthMask(GL_FALSE);
+    glUniform1i(uniform(id, "u_has_ground"), o.ground.has_value());
+    glUniform1f(uniform(id, "u_ground"), o.ground.value_or(0.f));
     if (o.ground) {
       glUniform1i(uniform(id, "u_kind"), 0);
       glUniform3f(uniform(id, "u_center"), ground_centre.x, ground_centre.y, ground_centre.z);

@@ -208,6 +208,42 @@ TEST(GlRender, GroundAndSpheresWhereTheModelDoesNotHideThem) {
   EXPECT_NEAR(picked->y, 1.f, 0.01f);
 }
 
+// The ground hides what of a sphere lies under it: a sphere wholly under the ground leaves the
+// frame as it is without it, and one half under shows its upper half.
+TEST(GlRender, TheGroundHidesWhatOfASphereIsUnderIt) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(16, 16);  // horizontal, 0.75 m wide, at y = 1
+  const int w = 256, h = 256;
+  const float ground_y = 0.6f;
+  const Vec3f under = {0.6f, ground_y - 0.1f, 0.f}, half = {-0.6f, ground_y, 0.f};
+  gl::RenderOptions look{w, h};
+  look.ground = ground_y;
+  gl::Renderer ground_only(m, look);
+  look.spheres = {{under, 0.08f}, {half, 0.08f}};
+  gl::Renderer r(m, look);
+  ground_only.draw(rest_state(m));
+  r.draw(rest_state(m));
+  const auto a = ground_only.pixels(), b = r.pixels();
+  const gl::Camera cam = gl::framing(m, ground_y);
+  auto changed_near = [&](Vec3f centre) {
+    const auto [sx, sy] = cam.pixel(centre, w, h);
+    long n = 0;
+    for (int y = std::max(0, int(sy) - 30); y < std::min(h, int(sy) + 30); ++y)
+      for (int x = std::max(0, int(sx) - 30); x < std::min(w, int(sx) + 30); ++x) {
+        const std::size_t i = (std::size_t(y) * w + x) * 4;
+        n += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
+      }
+    return n;
+  };
+  EXPECT_EQ(changed_near(under), 0) << "pixels of the sphere under the ground";
+  EXPECT_GT(changed_near(half), 100) << "the upper half of the sphere on the ground";
+  const auto [tx, ty] = cam.pixel(half + Vec3f{0.f, 0.07f, 0.f}, w, h);
+  const auto [bx, by] = cam.pixel(half - Vec3f{0.f, 0.07f, 0.f}, w, h);
+  const std::uint8_t *top = &b[(std::size_t(ty) * w + int(tx)) * 4], *bottom = &b[(std::size_t(by) * w + int(bx)) * 4];
+  EXPECT_GT(int(top[2]), int(top[0]) + 20) << "blue-grey near its top";
+  EXPECT_LE(std::abs(int(bottom[2]) - int(bottom[0])), 12) << "grey ground over its bottom";
+}
+
 TEST(GlRender, LatticeAsPointsAndPngFile) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_lattice(6, 5, 4);
