@@ -279,7 +279,8 @@ struct Renderer::Impl {
 
   // After the model, depth-tested without writing depth: the model hides them, and surface_at
   // finds only the model. A sphere culls its back faces (convex: each pixel gets its front) and
-  // drops what lies on the other side of the ground from the eye (obstacle.frag).
+  // drops what lies on the other side of the ground from the eye (obstacle.frag); spheres that
+  // cut into each other are drawn whole, the nearer centre over the other.
   void draw_obstacles(const Mat4& vp) {
     if (!obstacle_prog) return;
     const GLuint id = obstacle_prog.id();
@@ -299,7 +300,12 @@ struct Renderer::Impl {
     glEnable(GL_CULL_FACE);
     glUniform1i(uniform(id, "u_kind"), 1);
     glUniform2i(uniform(id, "u_grid"), kSphereSlices, kSphereStacks);
-    for (const Sphere& sphere : o.spheres) {
+    // The farthest first, so that a nearer sphere covers one behind it.
+    std::vector<Sphere> spheres = o.spheres;
+    std::sort(spheres.begin(), spheres.end(), [&](const Sphere& a, const Sphere& b) {
+      return norm(a.center - camera.eye) > norm(b.center - camera.eye);
+    });
+    for (const Sphere& sphere : spheres) {
       glUniform3f(uniform(id, "u_center"), sphere.center.x, sphere.center.y, sphere.center.z);
       glUniform1f(uniform(id, "u_size"), sphere.radius);
       glDrawArrays(GL_TRIANGLES, 0, 6 * kSphereSlices * kSphereStacks);

@@ -244,6 +244,34 @@ TEST(GlRender, TheGroundHidesWhatOfASphereIsUnderIt) {
   EXPECT_LE(std::abs(int(bottom[2]) - int(bottom[0])), 12) << "grey ground over its bottom";
 }
 
+// A sphere in front of another covers it, whatever their order in the scene.
+TEST(GlRender, ANearerSphereCoversOneBehindIt) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(16, 16);
+  const int w = 256, h = 256;
+  const gl::Camera cam = gl::framing(m, std::nullopt);
+  const Vec3f near = {0.f, 1.25f, 0.f}, ray = (near - cam.eye) * (1.f / norm(near - cam.eye));
+  const Vec3f far = near + ray * 0.3f + Vec3f{0.f, 0.08f, 0.f};  // its edge behind the near one's centre
+  gl::RenderOptions look{w, h};
+  look.spheres = {{near, 0.05f}};
+  gl::Renderer alone(m, look);
+  look.spheres = {{near, 0.05f}, {far, 0.12f}};
+  gl::Renderer both(m, look);
+  alone.draw(rest_state(m));
+  both.draw(rest_state(m));
+  const auto a = alone.pixels(), b = both.pixels();
+  const auto [sx, sy] = cam.pixel(near, w, h);
+  ASSERT_TRUE(sx > 3 && sx < w - 4 && sy > 3 && sy < h - 4) << "the near sphere is in view";
+  long differ = 0, inside = 0;
+  for (int y = int(sy) - 3; y <= int(sy) + 3; ++y)
+    for (int x = int(sx) - 3; x <= int(sx) + 3; ++x, ++inside) {
+      const std::size_t i = (std::size_t(y) * w + x) * 4;
+      differ += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
+    }
+  EXPECT_EQ(differ, 0) << "of " << inside << " pixels at the near sphere's centre, the far sphere drawn over it";
+  EXPECT_GT(coverage(b, w, h).pixels, coverage(a, w, h).pixels + 200) << "the far sphere around the near one";
+}
+
 TEST(GlRender, LatticeAsPointsAndPngFile) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = small_lattice(6, 5, 4);
