@@ -32,6 +32,30 @@ Coverage coverage(const std::vector<std::uint8_t>& px, int w, int h) {
   return c;
 }
 
+// Pixels that differ between frames a and b (w x h) in the square of cx, cy and `half` pixels
+// to each side, within the frame.
+long pixels_differing(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b, int w, int h, int cx,
+                      int cy, int half) {
+  long n = 0;
+  for (int y = std::max(0, cy - half); y <= std::min(h - 1, cy + half); ++y)
+    for (int x = std::max(0, cx - half); x <= std::min(w - 1, cx + half); ++x) {
+      const std::size_t i = (std::size_t(y) * w + x) * 4;
+      n += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
+    }
+  return n;
+}
+
+// Frames of m at rest drawn with `look`, and with `look` and the spheres `more` after its own.
+std::array<std::vector<std::uint8_t>, 2> without_and_with(const Model& m, gl::RenderOptions look,
+                                                          const std::vector<Sphere>& more) {
+  gl::Renderer without(m, look);
+  look.spheres.insert(look.spheres.end(), more.begin(), more.end());
+  gl::Renderer with(m, look);
+  without.draw(rest_state(m));
+  with.draw(rest_state(m));
+  return {without.pixels(), with.pixels()};
+}
+
 void expect_centred(const Coverage& c, int w, int h, double min_fraction, const std::string& what) {
   const double frac = double(c.pixels) / (double(w) * h);
   EXPECT_GT(frac, min_fraction) << what << ": too few pixels drawn";
@@ -218,22 +242,11 @@ TEST(GlRender, TheGroundHidesWhatOfASphereIsUnderIt) {
   const Vec3f under = {0.6f, ground_y - 0.1f, 0.f}, half = {-0.6f, ground_y, 0.f};
   gl::RenderOptions look{w, h};
   look.ground = ground_y;
-  gl::Renderer ground_only(m, look);
-  look.spheres = {{under, 0.08f}, {half, 0.08f}};
-  gl::Renderer r(m, look);
-  ground_only.draw(rest_state(m));
-  r.draw(rest_state(m));
-  const auto a = ground_only.pixels(), b = r.pixels();
+  const auto [a, b] = without_and_with(m, look, {{under, 0.08f}, {half, 0.08f}});
   const gl::Camera cam = gl::framing(m, ground_y);
   auto changed_near = [&](Vec3f centre) {
     const auto [sx, sy] = cam.pixel(centre, w, h);
-    long n = 0;
-    for (int y = std::max(0, int(sy) - 30); y < std::min(h, int(sy) + 30); ++y)
-      for (int x = std::max(0, int(sx) - 30); x < std::min(w, int(sx) + 30); ++x) {
-        const std::size_t i = (std::size_t(y) * w + x) * 4;
-        n += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
-      }
-    return n;
+    return pixels_differing(a, b, w, h, int(sx), int(sy), 30);
   };
   EXPECT_EQ(changed_near(under), 0) << "pixels of the sphere under the ground";
   EXPECT_GT(changed_near(half), 100) << "the upper half of the sphere on the ground";
@@ -254,21 +267,11 @@ TEST(GlRender, ANearerSphereCoversOneBehindIt) {
   const Vec3f far = near + ray * 0.3f + Vec3f{0.f, 0.08f, 0.f};  // its edge behind the near one's centre
   gl::RenderOptions look{w, h};
   look.spheres = {{near, 0.05f}};
-  gl::Renderer alone(m, look);
-  look.spheres = {{near, 0.05f}, {far, 0.12f}};
-  gl::Renderer both(m, look);
-  alone.draw(rest_state(m));
-  both.draw(rest_state(m));
-  const auto a = alone.pixels(), b = both.pixels();
+  const auto [a, b] = without_and_with(m, look, {{far, 0.12f}});  // the far sphere after the near one
   const auto [sx, sy] = cam.pixel(near, w, h);
   ASSERT_TRUE(sx > 3 && sx < w - 4 && sy > 3 && sy < h - 4) << "the near sphere is in view";
-  long differ = 0, inside = 0;
-  for (int y = int(sy) - 3; y <= int(sy) + 3; ++y)
-    for (int x = int(sx) - 3; x <= int(sx) + 3; ++x, ++inside) {
-      const std::size_t i = (std::size_t(y) * w + x) * 4;
-      differ += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
-    }
-  EXPECT_EQ(differ, 0) << "of " << inside << " pixels at the near sphere's centre, the far sphere drawn over it";
+  EXPECT_EQ(pixels_differing(a, b, w, h, int(sx), int(sy), 3), 0)
+      << "of 49 pixels at the near sphere's centre, the far sphere drawn over it";
   EXPECT_GT(coverage(b, w, h).pixels, coverage(a, w, h).pixels + 200) << "the far sphere around the near one";
 }
 
