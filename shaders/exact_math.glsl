@@ -21,9 +21,13 @@
 
 float dl_guess(float a) { return uintBitsToFloat(uint(int(floatBitsToUint(a)) + DL_GUESS_ULPS)); }
 
-// floor(a / b) for b > 0, dividing non-negative integers only (the rounding of a negative
-// quotient is no promise of GLSL's).
-int dl_floor_div(int a, int b) { return a >= 0 ? a / b : -((b - 1 - a) / b); }
+// floor(a / b) for 2^23 <= b < 2^26 and |a| < 2^31 - b (the residuals below): a float quotient,
+// within 2^-13 of a / b however GLSL's division rounds, then one exact integer correction. (With
+// integer divisions instead, glsl-compute's exact step took 23% longer on an H100.)
+int dl_floor_div(int a, int b) {
+  int k = int(floor(float(a) / float(b))), r = a - k * b;
+  return r < 0 ? k - 1 : (r >= b ? k + 1 : k);
+}
 
 // A finite non-zero magnitude's bits as m 2^(e - 23), m = 2^23 + f in [2^23, 2^24).
 void dl_split(uint mag, out int e, out uint f) {

@@ -134,6 +134,72 @@ TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
   gl::check("exact math test");
 }
 
+// dl_floor_div(a, b), run on the GPU for each pair.
+std::vector<std::int32_t> floor_div_on_gl(const std::vector<std::int32_t>& ab) {
+  const gl::Program prog = gl::make_program_from_source(GL_COMPUTE_SHADER, "floor_div_test.comp",
+                                                        "#version 430 core\n" + gl::shader_file("exact_math.glsl") + R"(
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer In { ivec2 ab[]; };
+layout(std430, binding = 1) writeonly buffer Out { int q[]; };
+layout(location = 0) uniform uint u_n;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i < u_n) q[i] = dl_floor_div(ab[i].x, ab[i].y);
+}
+)");
+  const std::size_t n = ab.size() / 2;
+  const gl::Buffer in = gl::make_buffer(n * 8, ab.data()), out = gl::make_buffer(n * 4);
+  glUseProgram(prog.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
+  glUniform1ui(0, GLuint(n));
+  glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<std::int32_t> q(n);
+  gl::read_buffer(out.id(), 0, n * 4, q.data());
+  glUseProgram(0);
+  return q;
+}
+
+// dl_floor_div, which the two functions' integer steps use, is floor(a / b) over its domain
+// (2^23 <= b < 2^26, |a| < 2^31 - b): quotients near every integer from -256 to 256 (a = k b - 1,
+// k b, k b + 1, k b + b - 1) for divisors at the domain's ends and between, and random pairs.
+// The inputs include cases where a correctly rounded float quotient's floor is one too high and
+// one too low (counted here on the CPU), so that both of its corrections are exercised.
+TEST(ExactMath, FloorDivisionIsExactOverItsDomain) {
+  DEFORMLAB_REQUIRE_GL();
+  gl::context();
+  std::vector<std::int64_t> bs = {1 << 23, (1 << 23) + 1, (3 << 22) + 7, (1 << 24) - 1, 1 << 24, (1 << 25) + 3,
+                                  (1 << 26) - 1};
+  std::mt19937 rng(4);
+  for (int k = 0; k < 64; ++k) bs.push_back(std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng));
+  std::vector<std::int32_t> ab;
+  auto add = [&](std::int64_t a, std::int64_t b) {
+    if (std::abs(a) < (std::int64_t(1) << 31) - b) ab.insert(ab.end(), {std::int32_t(a), std::int32_t(b)});
+  };
+  for (std::int64_t b : bs)
+    for (std::int64_t k = -256; k <= 256; ++k)
+      for (std::int64_t a : {k * b - 1, k * b, k * b + 1, k * b + b - 1}) add(a, b);
+  for (int k = 0; k < (1 << 16); ++k) {
+    const std::int64_t b = std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng);
+    add(std::uniform_int_distribution<std::int64_t>(-(std::int64_t(1) << 31) + b + 1, (std::int64_t(1) << 31) - b - 1)(rng), b);
+  }
+  const std::vector<std::int32_t> q = floor_div_on_gl(ab);
+  std::size_t wrong = 0, float_high = 0, float_low = 0;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const std::int64_t a = ab[2 * i], b = ab[2 * i + 1];
+    const std::int64_t want = a >= 0 ? a / b : -((b - 1 - a) / b);
+    const auto guess = std::int64_t(std::floor(float(a) / float(b)));
+    float_high += guess > want;
+    float_low += guess < want;
+    if (q[i] != want && wrong++ < 5) ADD_FAILURE() << "dl_floor_div(" << a << ", " << b << ") = " << q[i] << ", want " << want;
+  }
+  EXPECT_EQ(wrong, 0u) << "of " << q.size() << " pairs";
+  EXPECT_GT(float_high, 0u) << "no input needs the downward correction";
+  EXPECT_GT(float_low, 0u) << "no input needs the upward correction";
+  gl::check("floor division test");
+}
+
 // math=exact is the default (the same bits as without the option); a value other than exact
 // or fast is refused naming the pipeline.
 TEST(MathOption, ExactIsTheDefaultAndOtherValuesAreRefused) {
