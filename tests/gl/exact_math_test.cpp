@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -14,6 +15,38 @@
 
 namespace deformlab::test {
 namespace {
+
+// A compute shader over exact_math.glsl (after `defines`) that writes out_[i] = `expr` of
+// a = in_[i] for i < u_n.
+std::string map_shader(const std::string& defines, const std::string& in_type, const std::string& out_type,
+                       const std::string& expr) {
+  return "#version 430 core\n" + defines + gl::shader_file("exact_math.glsl") +
+         "layout(local_size_x = 256) in;\n"
+         "layout(std430, binding = 0) readonly buffer In { " + in_type + " in_[]; };\n"
+         "layout(std430, binding = 1) writeonly buffer Out { " + out_type + " out_[]; };\n"
+         "layout(location = 0) uniform uint u_n;\n"
+         "void main() {\n"
+         "  uint i = gl_GlobalInvocationID.x;\n"
+         "  if (i < u_n) {\n"
+         "    " + in_type + " a = in_[i];\n"
+         "    out_[i] = " + expr + ";\n"
+         "  }\n"
+         "}\n";
+}
+
+// Runs a map_shader program over n inputs of in_size bytes into n outputs of out_size bytes.
+void run_map(const gl::Program& prog, const void* in, std::size_t in_size, void* out, std::size_t out_size,
+             std::size_t n) {
+  const gl::Buffer ib = gl::make_buffer(n * in_size, in), ob = gl::make_buffer(n * out_size);
+  glUseProgram(prog.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ib.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ob.id());
+  glUniform1ui(0, GLuint(n));
+  glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  gl::read_buffer(ob.id(), 0, n * out_size, out);
+  glUseProgram(0);
+}
 
 // dl_recip and dl_sqrt of floats given by their bits, run in a compute shader whose driver
 // starting values are moved by `guess_ulps` (DL_GUESS_ULPS).
@@ -26,37 +59,16 @@ class ExactMath {
   std::vector<std::uint32_t> run(const std::vector<std::uint32_t>& x) const {
     constexpr std::size_t kChunk = std::size_t(1) << 20;
     std::vector<std::uint32_t> out(2 * x.size());
-    glUseProgram(prog_.id());
-    for (std::size_t first = 0; first < x.size(); first += kChunk) {
-      const std::size_t n = std::min(kChunk, x.size() - first);
-      const gl::Buffer in = gl::make_buffer(n * 4, x.data() + first), res = gl::make_buffer(n * 8);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, res.id());
-      glUniform1ui(0, GLuint(n));
-      glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
-      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-      gl::read_buffer(res.id(), 0, n * 8, out.data() + 2 * first);
-    }
-    glUseProgram(0);
+    for (std::size_t first = 0; first < x.size(); first += kChunk)
+      run_map(prog_, x.data() + first, 4, out.data() + 2 * first, 8, std::min(kChunk, x.size() - first));
     return out;
   }
 
  private:
   static std::string source(int guess_ulps) {
-    return "#version 430 core\n#define DL_GUESS_ULPS " + std::to_string(guess_ulps) + "\n" +
-           gl::shader_file("exact_math.glsl") + R"(
-layout(local_size_x = 256) in;
-layout(std430, binding = 0) readonly buffer In { uint x_bits[]; };
-layout(std430, binding = 1) writeonly buffer Out { uvec2 results[]; };
-layout(location = 0) uniform uint u_n;
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i < u_n) {
-    float x = uintBitsToFloat(x_bits[i]);
-    results[i] = uvec2(floatBitsToUint(dl_recip(x)), floatBitsToUint(dl_sqrt(x)));
-  }
-}
-)";
+    return map_shader("#define DL_GUESS_ULPS " + std::to_string(guess_ulps) + "\n", "uint", "uvec2",
+                      "uvec2(floatBitsToUint(dl_recip(uintBitsToFloat(a))), "
+                      "floatBitsToUint(dl_sqrt(uintBitsToFloat(a))))");
   }
   gl::Program prog_;
 };
@@ -137,27 +149,9 @@ TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
 // dl_floor_div(a, b), run on the GPU for each pair.
 std::vector<std::int32_t> floor_div_on_gl(const std::vector<std::int32_t>& ab) {
   const gl::Program prog = gl::make_program_from_source(GL_COMPUTE_SHADER, "floor_div_test.comp",
-                                                        "#version 430 core\n" + gl::shader_file("exact_math.glsl") + R"(
-layout(local_size_x = 256) in;
-layout(std430, binding = 0) readonly buffer In { ivec2 ab[]; };
-layout(std430, binding = 1) writeonly buffer Out { int q[]; };
-layout(location = 0) uniform uint u_n;
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i < u_n) q[i] = dl_floor_div(ab[i].x, ab[i].y);
-}
-)");
-  const std::size_t n = ab.size() / 2;
-  const gl::Buffer in = gl::make_buffer(n * 8, ab.data()), out = gl::make_buffer(n * 4);
-  glUseProgram(prog.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
-  glUniform1ui(0, GLuint(n));
-  glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<std::int32_t> q(n);
-  gl::read_buffer(out.id(), 0, n * 4, q.data());
-  glUseProgram(0);
+                                                        map_shader("", "ivec2", "int", "dl_floor_div(a.x, a.y)"));
+  std::vector<std::int32_t> q(ab.size() / 2);
+  run_map(prog, ab.data(), 8, q.data(), 4, q.size());
   return q;
 }
 
@@ -182,7 +176,8 @@ TEST(ExactMath, FloorDivisionIsExactOverItsDomain) {
       for (std::int64_t a : {k * b - 1, k * b, k * b + 1, k * b + b - 1}) add(a, b);
   for (int k = 0; k < (1 << 16); ++k) {
     const std::int64_t b = std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng);
-    add(std::uniform_int_distribution<std::int64_t>(-(std::int64_t(1) << 31) + b + 1, (std::int64_t(1) << 31) - b - 1)(rng), b);
+    const std::int64_t reach = (std::int64_t(1) << 31) - b - 1;
+    add(std::uniform_int_distribution<std::int64_t>(-reach, reach)(rng), b);
   }
   const std::vector<std::int32_t> q = floor_div_on_gl(ab);
   std::size_t wrong = 0, float_high = 0, float_low = 0;
@@ -192,7 +187,8 @@ TEST(ExactMath, FloorDivisionIsExactOverItsDomain) {
     const auto guess = std::int64_t(std::floor(float(a) / float(b)));
     float_high += guess > want;
     float_low += guess < want;
-    if (q[i] != want && wrong++ < 5) ADD_FAILURE() << "dl_floor_div(" << a << ", " << b << ") = " << q[i] << ", want " << want;
+    if (q[i] != want && wrong++ < 5)
+      ADD_FAILURE() << "dl_floor_div(" << a << ", " << b << ") = " << q[i] << ", want " << want;
   }
   EXPECT_EQ(wrong, 0u) << "of " << q.size() << " pairs";
   EXPECT_GT(float_high, 0u) << "no input needs the downward correction";
