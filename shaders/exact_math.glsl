@@ -3,8 +3,8 @@
 // evaluate dot() as it likes.
 //
 // The method: x is read by its bits as a 24-bit significand m and an exponent. The driver's
-// 1/x or inversesqrt of the significand is only a starting value y (it may be 32 ulp off;
-// GLSL allows 2.5 and 2). Its residual (1/x: 2^47 - m y; sqrt: m 2^23 - y^2), exact in
+// 1/x or inversesqrt of the significand is only a starting value y (it may be 30 ulp off, which
+// keeps sqrt's residual within an int; GLSL allows 2.5 and 2). Its residual (1/x: 2^47 - m y; sqrt: m 2^23 - y^2), exact in
 // integers (umulExtended), corrects it by an exact integer step (a division; for sqrt a
 // Newton step, which lands on the root or just above it, then one check) to the floor of the
 // exact result, whose remainder then rounds it to nearest (the exact result is never a
@@ -21,9 +21,10 @@
 
 float dl_guess(float a) { return uintBitsToFloat(uint(int(floatBitsToUint(a)) + DL_GUESS_ULPS)); }
 
-// floor(a / b) for 2^23 <= b < 2^26 and |a| < 2^31 - b (the residuals below): a float quotient,
-// within 2^-13 of a / b however GLSL's division rounds, then one exact integer correction. (With
-// integer divisions instead, glsl-compute's exact step took 23% longer on an H100.)
+// floor(a / b) for 2^23 <= b < 2^26: a float quotient, within 2^-13 of a / b (below 256 in
+// magnitude) however GLSL's division rounds, then one correction by the remainder, which is
+// exact (int * and - wrap). With integer divisions instead, glsl-compute's exact step took 23%
+// longer on an H100.
 int dl_floor_div(int a, int b) {
   int k = int(floor(float(a) / float(b))), r = a - k * b;
   return r < 0 ? k - 1 : (r >= b ? k + 1 : k);

@@ -1,6 +1,7 @@
 // The GL pipelines' option math: exact (the default) runs shaders/exact_math.glsl.
 #include <algorithm>
 #include <bit>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -124,8 +125,8 @@ std::vector<std::uint32_t> random_bits(std::size_t n, std::uint32_t lo, std::uin
 // on every float in [1, 4) (every significand with both exponent parities: the functions reduce
 // their argument to there by its bits), on the edge cases, and on random bit patterns (every
 // exponent and sign, subnormals and NaNs). Again on the edge cases and samples with the
-// driver's starting values moved by 3 ulp (past GLSL's 2.5 for 1/x) and by 24 ulp (the method
-// takes them within 32), which must not change a bit: llvmpipe's 1/x and sqrt are correctly
+// driver's starting values moved by 3 ulp (past GLSL's 2.5 for 1/x), 24 and 30 ulp (the method
+// takes them within 30), which must not change a bit: llvmpipe's 1/x and sqrt are correctly
 // rounded already, a GPU's are not.
 TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
   DEFORMLAB_REQUIRE_GL();
@@ -136,7 +137,7 @@ TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
   expect_correctly_rounded(driver, one_to_four, "[1, 4)");
   expect_correctly_rounded(driver, edge_cases(), "edge cases");
   expect_correctly_rounded(driver, random_bits(std::size_t(1) << 20, 0u, 0xffffffffu, 1), "random bits");
-  for (int ulps : {-24, -3, 3, 24}) {
+  for (int ulps : {-30, -24, -3, 3, 24, 30}) {
     const ExactMath moved(ulps);
     const std::string what = "starting values moved by " + std::to_string(ulps) + " ulp, ";
     expect_correctly_rounded(moved, edge_cases(), what + "edge cases");
@@ -146,51 +147,54 @@ TEST(ExactMath, ReciprocalAndSquareRootAreCorrectlyRounded) {
   gl::check("exact math test");
 }
 
-// dl_floor_div(a, b), run on the GPU for each pair.
+// dl_floor_div(a, b) and the floor of the float quotient it starts from, run on the GPU for
+// each pair.
 std::vector<std::int32_t> floor_div_on_gl(const std::vector<std::int32_t>& ab) {
-  const gl::Program prog = gl::make_program_from_source(GL_COMPUTE_SHADER, "floor_div_test.comp",
-                                                        map_shader("", "ivec2", "int", "dl_floor_div(a.x, a.y)"));
-  std::vector<std::int32_t> q(ab.size() / 2);
-  run_map(prog, ab.data(), 8, q.data(), 4, q.size());
+  const gl::Program prog = gl::make_program_from_source(
+      GL_COMPUTE_SHADER, "floor_div_test.comp",
+      map_shader("", "ivec2", "ivec2", "ivec2(dl_floor_div(a.x, a.y), int(floor(float(a.x) / float(a.y))))"));
+  std::vector<std::int32_t> q(ab.size());
+  run_map(prog, ab.data(), 8, q.data(), 8, ab.size() / 2);
   return q;
 }
 
 // dl_floor_div, which the two functions' integer steps use, is floor(a / b) over its domain
-// (2^23 <= b < 2^26, |a| < 2^31 - b): quotients near every integer from -256 to 256 (a = k b - 1,
-// k b, k b + 1, k b + b - 1) for divisors at the domain's ends and between, and random pairs.
-// The inputs include cases where a correctly rounded float quotient's floor is one too high and
-// one too low (counted here on the CPU), so that both of its corrections are exercised.
+// (every int a, 2^23 <= b < 2^26): quotients near every integer an int allows (a = k b - 1, k b,
+// k b + 1, k b + b - 1, up to |k| = 256) for divisors at the domain's ends and between, and
+// random pairs. Some inputs need each of its two corrections on the device under test: the floor
+// of its float quotient is one too high for some and one too low for others.
 TEST(ExactMath, FloorDivisionIsExactOverItsDomain) {
   DEFORMLAB_REQUIRE_GL();
   gl::context();
+  constexpr std::int64_t kMin = INT32_MIN, kMax = INT32_MAX;
   std::vector<std::int64_t> bs = {1 << 23, (1 << 23) + 1, (3 << 22) + 7, (1 << 24) - 1, 1 << 24, (1 << 25) + 3,
                                   (1 << 26) - 1};
   std::mt19937 rng(4);
   for (int k = 0; k < 64; ++k) bs.push_back(std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng));
   std::vector<std::int32_t> ab;
   auto add = [&](std::int64_t a, std::int64_t b) {
-    if (std::abs(a) < (std::int64_t(1) << 31) - b) ab.insert(ab.end(), {std::int32_t(a), std::int32_t(b)});
+    if (a >= kMin && a <= kMax) ab.insert(ab.end(), {std::int32_t(a), std::int32_t(b)});
   };
-  for (std::int64_t b : bs)
+  for (std::int64_t b : bs) {
     for (std::int64_t k = -256; k <= 256; ++k)
       for (std::int64_t a : {k * b - 1, k * b, k * b + 1, k * b + b - 1}) add(a, b);
-  for (int k = 0; k < (1 << 16); ++k) {
-    const std::int64_t b = std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng);
-    const std::int64_t reach = (std::int64_t(1) << 31) - b - 1;
-    add(std::uniform_int_distribution<std::int64_t>(-reach, reach)(rng), b);
+    add(kMin, b);
+    add(kMax, b);
   }
+  for (int k = 0; k < (1 << 16); ++k)
+    add(std::uniform_int_distribution<std::int64_t>(kMin, kMax)(rng),
+        std::uniform_int_distribution<std::int64_t>(1 << 23, (1 << 26) - 1)(rng));
   const std::vector<std::int32_t> q = floor_div_on_gl(ab);
   std::size_t wrong = 0, float_high = 0, float_low = 0;
-  for (std::size_t i = 0; i < q.size(); ++i) {
-    const std::int64_t a = ab[2 * i], b = ab[2 * i + 1];
+  for (std::size_t i = 0; i < ab.size(); i += 2) {
+    const std::int64_t a = ab[i], b = ab[i + 1];
     const std::int64_t want = a >= 0 ? a / b : -((b - 1 - a) / b);
-    const auto guess = std::int64_t(std::floor(float(a) / float(b)));
-    float_high += guess > want;
-    float_low += guess < want;
+    float_high += q[i + 1] > want;
+    float_low += q[i + 1] < want;
     if (q[i] != want && wrong++ < 5)
       ADD_FAILURE() << "dl_floor_div(" << a << ", " << b << ") = " << q[i] << ", want " << want;
   }
-  EXPECT_EQ(wrong, 0u) << "of " << q.size() << " pairs";
+  EXPECT_EQ(wrong, 0u) << "of " << ab.size() / 2 << " pairs";
   EXPECT_GT(float_high, 0u) << "no input needs the downward correction";
   EXPECT_GT(float_low, 0u) << "no input needs the upward correction";
   gl::check("floor division test");
