@@ -2,15 +2,15 @@
 // exact math (sim.glsl): GLSL lets a driver approximate 1/x (2.5 ulp) and sqrt (more), and
 // evaluate dot() as it likes.
 //
-// The method: x is read by its bits as a 24-bit significand m and an exponent. The driver's
-// 1/x or inversesqrt of the significand is only a starting value y (it may be 30 ulp off, which
+// The method: x is read by its bits as a 24-bit significand m and an exponent. The driver's 1/x
+// or inversesqrt of the significand is only a starting value y (it may be 30 ulp off, which
 // keeps sqrt's residual within an int; GLSL allows 2.5 and 2). Its residual (1/x: 2^47 - m y;
 // sqrt: m 2^23 - y^2), exact in integers (umulExtended), corrects it by an exact integer step
-// (a division; for sqrt a
-// Newton step, which lands on the root or just above it, then one check) to the floor of the
-// exact result, whose remainder then rounds it to nearest (the exact result is never a
-// midpoint). The exponent goes back by the bits, a subnormal 1/x rounded there by the same
-// remainder. GLSL's fma() would not do: it need not round once (llvmpipe's does not).
+// (a division; for sqrt a Newton step, which lands on the root or just above it, then one
+// check) to the floor of the exact result, whose remainder then rounds it to nearest (the exact
+// result is never a midpoint). The exponent goes back by the bits, a subnormal 1/x rounded
+// there by the same remainder. GLSL's fma() would not do: it need not round once (llvmpipe's
+// does not).
 // Results: IEEE round to nearest even for every finite x, subnormal x included (read by its
 // bits, whatever the hardware flushes); 1/+-0 = +-inf, 1/+-inf = +-0, sqrt(+-0) = +-0,
 // sqrt(x < 0) = NaN, sqrt(+inf) = +inf, NaN stays NaN.
@@ -22,22 +22,14 @@
 
 float dl_guess(float a) { return uintBitsToFloat(uint(int(floatBitsToUint(a)) + DL_GUESS_ULPS)); }
 
-// floor(a / b) for 2^23 <= b < 2^26, and r = a - floor(a / b) b in [0, b): a float quotient,
-// within 2^-13 of a / b (below 256 in magnitude) however GLSL's division rounds, then one
-// correction by the remainder, which is exact (int * and - wrap). With integer divisions
-// instead, glsl-compute's exact step took 23% longer on an H100.
-int dl_floor_div(int a, int b, out int r) {
-  int k = int(floor(float(a) / float(b)));
-  r = a - k * b;
-  if (r < 0) {
-    r += b;
-    return k - 1;
-  }
-  if (r >= b) {
-    r -= b;
-    return k + 1;
-  }
-  return k;
+// floor(a / b) for 2^23 <= b < 2^26: a float quotient, within 2^-13 of a / b (below 256 in
+// magnitude) however GLSL's division rounds, then one correction by the remainder, which is
+// exact (int * and - wrap). With integer divisions instead, glsl-compute's exact step took 23%
+// longer on an H100; handing the remainder back (for dl_recip_floor, which computes it again)
+// took 1-4% longer there, with branches or selects.
+int dl_floor_div(int a, int b) {
+  int k = int(floor(float(a) / float(b))), r = a - k * b;
+  return r < 0 ? k - 1 : (r >= b ? k + 1 : k);
 }
 
 // A finite non-zero magnitude's bits as m 2^(e - 23), m = 2^23 + f in [2^23, 2^24).
@@ -57,8 +49,8 @@ uint dl_recip_floor(uint m, out uint r) {
   uint y = uint(dl_guess(1.0 / (float(m) * 1.1920928955078125e-7)) * 16777216.0), hi, lo;
   umulExtended(m, y, hi, lo);
   int d = int(0u - lo);  // 2^47 - m y, whose magnitude is below 2^31
-  int rem, k = dl_floor_div(d, int(m), rem);
-  r = uint(rem);
+  int k = dl_floor_div(d, int(m));
+  r = uint(d - k * int(m));
   return uint(int(y) + k);
 }
 
@@ -95,8 +87,7 @@ uint dl_sqrt_floor(uint m, out uint d) {
   uint y = uint(g * dl_guess(inversesqrt(g)) * 8388608.0), hi, lo;
   umulExtended(y, y, hi, lo);
   int t = int((m << 23) - lo);  // n - y^2, whose magnitude is below 2^31
-  int rem;
-  y = uint(int(y) + dl_floor_div(t, int(2u * y), rem));
+  y = uint(int(y) + dl_floor_div(t, int(2u * y)));
   umulExtended(y, y, hi, lo);
   t = int((m << 23) - lo);
   if (t < 0) {
