@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "core/clock_watch.hpp"
 #include "core/cpu_backend.hpp"
 #include "core/run.hpp"
 #include "experiments/output.hpp"
@@ -39,6 +40,7 @@ struct Ran {
   RunResult result;
   json frames;  // the frames' manifest with --frames, else null
   WarmUp warm_up;
+  ClockSummary clock;  // the GPU's clock over the run, on pipelines with a GPU pass
 };
 
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
@@ -49,6 +51,9 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   WarmUp warm;
   if (warm_ms > 0.0) warm = warm_up_from_rest(pipe, in.model, warm_ms);
   else pipe.set_state(rest_state(in.model));
+  std::optional<ClockWatch> watch;
+  if (on_gpu(*in.entry)) watch.emplace();
+  const auto clock = [&] { return watch ? watch->stop() : ClockSummary{}; };
   RunOptions opt;
   opt.until_converged = in.until_converged;
   opt.integrator = in.integ;
@@ -62,7 +67,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
       frames->after_step(pipe, step);
     };
   }
-  Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm};
+  Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm, clock()};
   if (frames) {
     frames->finish(pipe, ran.result.steps);
     ran.frames = frames->manifest();
@@ -71,7 +76,8 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
 #else
   (void)a;
   (void)dir;
-  return {run(pipe, in.model, in.params, opt), nullptr, warm};
+  RunResult result = run(pipe, in.model, in.params, opt);
+  return {std::move(result), nullptr, warm, clock()};
 #endif
 }
 
@@ -143,7 +149,8 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
                   {"wall_ms", r.wall_ms}, {"wall_clock", "host steady_clock from the first step to the device's end "
                                                          "of the last, checks and frames included"},
                   {"median_step_ms", med.step_ms}, {"step_clock", r.clock},
-                  {"median_queue_ms_host_clock", med.queue_ms}, {"stage_timing", pipe.timing_method()}}},
+                  {"median_queue_ms_host_clock", med.queue_ms}, {"stage_timing", pipe.timing_method()},
+                  {"sm_clock", to_json(ran.clock)}}},
       {"stages", stages_of(profiler)},
       {"stages_timed_in", profiler.sampled_steps()},
       {"files", {{"timings.csv", "per step: step, t_s, step_ms (on the step clock), queue_ms (host clock around "
@@ -159,10 +166,11 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
   return manifest;
 }
 
-void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r, const WarmUp& warm,
-                   const Profiler& profiler, const StepMedians& med, const json& compare, const OutputDir& dir,
+void print_summary(const RunArgs& a, const RunInput& in, const Ran& ran, const Profiler& profiler, const StepMedians& med, const json& compare, const OutputDir& dir,
                    double setup_s) {
   const Model& m = in.model;
+  const RunResult& r = ran.result;
+  const WarmUp& warm = ran.warm_up;
   std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name) << " on " << in.entry->name << " ("
             << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
             << m.spring_count() << " springs\n";
@@ -179,6 +187,7 @@ void print_summary(const RunArgs& a, const RunInput& in, const RunResult& r, con
     std::cout << "; queueing a step took " << med.queue_ms << " ms on the host clock";
   std::cout << "; the run took " << r.wall_ms / 1000.0 << " s on the host clock (checks"
             << (a.frames ? ", frames" : "") << " included)\n";
+  if (on_gpu(*in.entry)) std::cout << "  clock: " << describe(ran.clock) << "\n";
   if (a.compare)
     std::cout << "  compare: largest position error vs the double reference: "
               << compare["max_position_error_relative_to_extent"].get<double>() << " of the model's extent\n";
@@ -253,7 +262,7 @@ int run_command(const RunArgs& a) {
 #endif
     write_json(dir.staged("manifest.json"), manifest);
     dir.commit();
-    print_summary(a, in, r, ran.warm_up, profiler, med, compare, dir, setup_s);
+    print_summary(a, in, ran, profiler, med, compare, dir, setup_s);
     return 0;
   });
 }

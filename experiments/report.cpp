@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/clock_watch.hpp"
 #include "paper.hpp"
 #include "plot.hpp"
 #include "report_parts.hpp"
@@ -88,6 +89,16 @@ void write_setup(Report& r) {
     if (status != "available") r.md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
 }
 
+// The GPU's clock over the cells' timed batches (cells with `sm_clock`).
+void write_clocks(Report& r) {
+  ClockTally tally;
+  for (const auto& c : r.cells)
+    if (c["status"] == "ok" && c.contains("sm_clock")) tally.add(c["id"].get<std::string>(), clock_summary(c["sm_clock"]));
+  if (!tally.empty())
+    r.md << "- GPU clock over the timed batches (NVML, sampled every " << ClockWatch::kPeriodMs
+         << " ms): " << tally.describe("cell") << "\n";
+}
+
 // How the cells were timed, as the first measured cell says, and each step clock with the
 // pipelines it times.
 void write_method(Report& r) {
@@ -116,6 +127,7 @@ void write_method(Report& r) {
     }
     r.md << "\n";
   }
+  write_clocks(r);
   r.md << "\n";
 }
 

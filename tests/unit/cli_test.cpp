@@ -36,10 +36,32 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_NE(r.out.find("passes timed in steps 1-8 of every 64"), std::string::npos) << r.out;
   EXPECT_EQ(m["scene"]["model"]["size"], nlohmann::json::array({8, 6}));
   EXPECT_EQ(m["warm_up"]["steps"], 0) << "CPU pipelines start at once";
+  EXPECT_TRUE(m["result"]["sm_clock"].is_null());
+  EXPECT_EQ(r.out.find("  clock:"), std::string::npos) << r.out;
   EXPECT_LT(m["compare"]["max_position_error_relative_to_extent"].get<double>(), 1e-5);
   EXPECT_TRUE(m["build"].contains("compiler"));
   EXPECT_TRUE(m["machine"].contains("hardware_threads"));
   EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
+}
+
+// A run on a GPU pipeline says at what clock the GPU ran its steps (NVML, where the NVIDIA driver
+// is) or that the clock was not read; a CPU run says nothing of it (above: no "clock:" line).
+TEST_F(Cli, GpuRunSaysTheClockItsStepsRanAt) {
+  const fs::path out = dir_ / "run";
+  const Result r = run("run --pipeline glsl-compute --grid 16x16 --steps 20 --warmup-ms 0 --no-state --out " +
+                       out.string());
+  if (r.err.find("is not available") != std::string::npos) GTEST_SKIP() << r.err;
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
+  const nlohmann::json& clock = m["result"]["sm_clock"];
+  if (clock.is_null()) {
+    EXPECT_NE(r.out.find("  clock: SM clock not read"), std::string::npos) << r.out;
+    return;
+  }
+  EXPECT_GT(clock["samples"].get<int>(), 0);
+  EXPECT_GT(clock["sm_mhz_median"].get<unsigned>(), 0u);
+  EXPECT_NE(r.out.find("  clock: SM clock " + std::to_string(clock["sm_mhz_min"].get<unsigned>()) + "-"),
+            std::string::npos) << r.out;
 }
 
 // The summary's stages: a run that checks once has its reductions in one step, and says so.
