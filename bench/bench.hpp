@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/clock_watch.hpp"
 #include "core/pipeline.hpp"
 #include "core/scene.hpp"
 
@@ -29,11 +30,17 @@ struct BenchScene {
   explicit BenchScene(const Scene& s);
 };
 
-// Median and spread of a list of timings (ms).
+// Median and spread of a list of timings (ms), and the GPU's clock while they were taken.
 struct Stats {
   double median = 0, min = 0, p90 = 0;
+  ClockSummary clock;  // not watched on the CPU
 };
 Stats stats(std::vector<double> ms);
+double mean(const std::vector<double>& ms);
+
+// A bench's last line: the GPU's clock over its cases' `timed` ("timed steps", ...).
+void print_clocks(std::ostream& os, const ClockTally& clocks, const std::string& timed);
+
 
 // `v` with `prec` decimals; "-" for NaN (not measured).
 std::string fixed(double v, int prec);

@@ -7,7 +7,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <numeric>
+#include <utility>
 
 #include "bench.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
@@ -42,20 +42,18 @@ std::string fused_block(Math m) {
   return cuda::to_string(cuda::default_tile(cuda::Variant::fused, m, Topology::cloth_grid));
 }
 
-double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); }
-
 // Median ms per step from the rest state: the warm-up (warm_up_from_rest, then o.warmup steps),
-// then o.batches batches of steps (each about a millisecond: 8 to 104 steps, a multiple of 8 so
-// that cuda-temporal's launches are whole), a batch's figure the mean of its steps, each step on
-// the pipeline's step clock (CUDA events).
-Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o) {
+// then steps back to back for about kGpuTimedMs (a multiple of 8, so that cuda-temporal's
+// launches are whole), each on the pipeline's step clock (CUDA events), as `deformlab run` times
+// its steps; the GPU `bus` watched over them.
+Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o, const std::string& bus) {
   warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
   const double warm = mean(timed_steps(p, *timer, o.warmup));
-  const int steps = (std::clamp(int(1.0 / std::max(warm, 1e-4)), 3, 100) + 7) / 8 * 8;
-  std::vector<double> ms;
-  for (int b = 0; b < o.batches; ++b) ms.push_back(mean(timed_steps(p, *timer, steps)));
-  return stats(ms);
+  ClockWatch watch(bus);
+  Stats s = stats(timed_steps(p, *timer, steps_spanning(kGpuTimedMs, warm, 8, 8)));
+  s.clock = watch.stop();
+  return s;
 }
 
 struct Row {
@@ -63,19 +61,21 @@ struct Row {
   bool graphs;
   std::int64_t nodes;
   double ms, floor_bytes, gbs, of_copy;
+  ClockSummary clock;  // over the timed steps; not watched for the bare gather
 };
 
 class Report {
  public:
-  Report(const CudaOptions& o, double copy_gbs)
+  Report(const CudaOptions& o, double copy_gbs, std::string bus)
       : copy_gbs_(copy_gbs),
+        bus_(std::move(bus)),
         csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
-                             "floor_bytes_per_node,effective_GBps,fraction_of_copy")) {}
+                             "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction")) {}
   Row measure(const std::string& table, SceneKind kind, const BenchScene& scene, Integrator integ,
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
     auto p = cuda::make_pipeline(scene.setup(integ), opt);
-    const Stats st = ms_per_step(*p, m, o);
+    const Stats st = ms_per_step(*p, m, o, bus_);
     Row r;
     r.table = table;
     r.scene = to_string(kind);
@@ -89,8 +89,14 @@ class Report {
     r.nodes = m.node_count();
     r.ms = st.median;
     r.floor_bytes = cuda::floor_bytes_per_node(m, integ, opt);
+    r.clock = st.clock;
+    clocks_.add(r.table + " " + r.grid + " " + r.variant + (k > 1 ? " k=" + std::to_string(k) : "") + " " +
+                    r.integrator + " " + r.math + " " + r.tile + (r.graphs ? "" : " no graphs"),
+                st.clock);
     return record(r, k);
   }
+
+  const ClockTally& clocks() const { return clocks_; }
 
   // The bare gather (cuda::bare_gather_ms) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
@@ -122,11 +128,15 @@ class Report {
     if (csv_)
       csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator
            << "," << r.tile << "," << r.math << "," << steps_per_launch << "," << r.graphs << "," << r.ms << ","
-           << r.floor_bytes << "," << r.gbs << "," << r.of_copy << "\n";
+           << r.floor_bytes << "," << r.gbs << "," << r.of_copy << ","
+           << (r.clock.watched() ? std::to_string(r.clock.sm_mhz_median) : "") << ","
+           << (r.clock.watched() ? std::to_string(r.clock.slowed) : "") << "\n";
     return r;
   }
 
   double copy_gbs_;
+  std::string bus_;
+  ClockTally clocks_;
   std::ofstream csv_;
 };
 
@@ -148,9 +158,8 @@ void run_cuda(const CudaOptions& o) {
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
             << "method: CUDA events around each step (the pipeline's step clock) after " << warm_up_words(o)
-            << o.warmup << " warm-up steps; batches of about 1 ms (3..100 steps) each giving its mean; median of "
-            << o.batches
-            << " batches, in ms per step.\n"
+            << o.warmup << " warm-up steps; the median of steps timed back to back for about "
+            << fixed(kGpuTimedMs, 0) << " ms (at least 8), in ms per step.\n"
             << "cloth grid n x n, 12 springs per interior node. " << describe(kind) << ";\n"
             << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
@@ -160,7 +169,7 @@ void run_cuda(const CudaOptions& o) {
             << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
-  Report rep(o, copy_gbs);
+  Report rep(o, copy_gbs, dev.pci_bus_id);
   std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", exact math, default tiles, step "
                "graphs on\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
@@ -279,6 +288,7 @@ void run_cuda(const CudaOptions& o) {
         }
     }
   }
+  print_clocks(std::cout, rep.clocks(), "timed steps");
 }
 
 }  // namespace
@@ -296,7 +306,8 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
-  c->add_option("--batches", o->batches, "Timed batches (the median is reported)")->check(CLI::PositiveNumber);
+  c->add_option("--batches", o->batches, "The bare gather's timed batches (the median is reported)")
+      ->check(CLI::PositiveNumber);
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
       ->check(CLI::PositiveNumber);
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");

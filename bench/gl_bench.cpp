@@ -2,6 +2,7 @@
 // pass-through transform feedback that only copies the two state attributes (the ceiling of
 // the transform-feedback route on this GPU) and glsl-compute's bare gather (its loads and
 // stores without its arithmetic).
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -16,12 +17,40 @@ namespace deformlab::bench {
 
 namespace {
 
-// GPU ms per step of a GL pipeline, each step on its step clock after the warm-up.
+// Timed steps after o.warmup more: back to back for about kGpuTimedMs, o.reps at the least.
+int timed_count(const std::vector<double>& warm_ms, const StepOptions& o) {
+  return steps_spanning(kGpuTimedMs, mean(warm_ms), o.reps);
+}
+
+// `work` timed on `timer` (after `prepare`, untimed, each time) o.warmup times, then timed_count
+// times back to back; the GPU's clock over the latter.
+Stats time_work(gl::Timer& timer, const std::function<void()>& prepare, const std::function<void()>& work,
+                const StepOptions& o) {
+  const auto timed = [&](int steps) {
+    for (int w = 0; w < steps; ++w) {
+      prepare();
+      timer.begin();
+      work();
+      timer.end();
+    }
+    return timer.take();
+  };
+  const int steps = timed_count(timed(o.warmup), o);
+  ClockWatch watch;
+  Stats s = stats(timed(steps));
+  s.clock = watch.stop();
+  return s;
+}
+
+// GPU ms per step of a GL pipeline, each step on its step clock after the warm-up; the GPU's
+// clock over the timed steps.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
-  timed_steps(p, *timer, o.warmup);
-  const Stats s = stats(timed_steps(p, *timer, o.reps));
+  const int n = timed_count(timed_steps(p, *timer, o.warmup), o);
+  ClockWatch watch;
+  Stats s = stats(timed_steps(p, *timer, n));
+  s.clock = watch.stop();
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
   return s;
 }
@@ -68,17 +97,11 @@ Stats time_passthrough(int n, const StepOptions& o) {
     glEndTransformFeedback();
   };
   warm_up(copy, glFinish, o.warmup_ms);
-  for (int w = 0; w < o.warmup + o.reps; ++w) {
-    if (w == o.warmup) timer.take();
-    timer.begin();
-    copy();
-    timer.end();
-  }
+  const Stats s = time_work(timer, [] {}, copy, o);
   glDisable(GL_RASTERIZER_DISCARD);
   glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
   glBindVertexArray(0);
   glUseProgram(0);
-  const Stats s = stats(timer.take());
   check("pass-through transform feedback");
   return s;
 }
@@ -115,15 +138,8 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
         dispatch();
       },
       glFinish, o.warmup_ms);
-  for (int w = 0; w < o.warmup + o.reps; ++w) {
-    if (w == o.warmup) timer.take();
-    bind();
-    timer.begin();
-    dispatch();
-    timer.end();
-  }
+  const Stats s = time_work(timer, bind, dispatch, o);
   glUseProgram(0);
-  const Stats s = stats(timer.take());
   check("the bare gather");
   return s;
 }
@@ -136,7 +152,8 @@ void run_gl(const StepOptions& o) {
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
             << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o) << o.warmup
-            << " warm-up steps, median of " << o.reps << " timed steps\n"
+            << " warm-up steps, the median of steps timed back to back for about " << fixed(kGpuTimedMs, 0)
+            << " ms (at least " << o.reps << ")\n"
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
                "the ceiling of the transform-feedback route\n"
             << "bare gather: glsl-compute's loads and stores (its work groups and stencil) without its arithmetic; "
@@ -144,7 +161,8 @@ void run_gl(const StepOptions& o) {
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
             << std::setw(14) << "tf/ceiling" << std::setw(14) << "bare gather" << std::setw(15) << "compute exact"
             << std::setw(14) << "compute fast" << std::setw(12) << "fast/bare" << "\n";
-  std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms");
+  std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms,sm_mhz_median,slowed_fraction");
+  ClockTally clocks;
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
@@ -173,15 +191,19 @@ void run_gl(const StepOptions& o) {
               << std::setw(14) << bare.median << std::setw(15) << compute.median << std::setw(14)
               << compute_fast.median << std::setw(12) << compute_fast.median / bare.median
               << (neighbours == "grid arithmetic" ? "" : "  (" + neighbours + ")") << "\n";
-    if (csv) {
-      const std::pair<const char*, Stats> rows[] = {
-          {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-bare-gather", bare}, {"glsl-compute", compute},
-          {"glsl-compute-fast", compute_fast}};
-      for (const auto& [what, s] : rows)
+    const std::pair<const char*, Stats> rows[] = {
+        {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-bare-gather", bare}, {"glsl-compute", compute},
+        {"glsl-compute-fast", compute_fast}};
+    for (const auto& [what, s] : rows) {
+      clocks.add(std::to_string(n) + "^2 " + what, s.clock);
+      if (csv)
         csv << '"' << ctx.renderer << "\"," << n << "x" << n << "," << m.node_count() << "," << what << ","
-            << s.median << "," << s.min << "," << s.p90 << "\n";
+            << s.median << "," << s.min << "," << s.p90 << ","
+            << (s.clock.watched() ? std::to_string(s.clock.sm_mhz_median) : "") << ","
+            << (s.clock.watched() ? std::to_string(s.clock.slowed) : "") << "\n";
     }
   }
+  print_clocks(std::cout, clocks, "timed steps");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iomanip>
 #include <memory>
+#include <numeric>
 #include <sstream>
 
 #include "bench.hpp"
@@ -49,6 +50,19 @@ Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};
   std::sort(ms.begin(), ms.end());
   return {median(ms), ms.front(), ms[std::min(ms.size() - 1, ms.size() * 9 / 10)]};
+}
+
+double mean(const std::vector<double>& ms) {
+  return ms.empty() ? 0.0 : std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size());
+}
+
+void print_clocks(std::ostream& os, const ClockTally& clocks, const std::string& timed) {
+  os << "\n[clock] ";
+  if (clocks.empty())
+    os << "the GPU's clock was not read (no NVIDIA driver's NVML here)\n";
+  else
+    os << "SM clock over each case's " << timed << " (NVML, sampled every " << ClockWatch::kPeriodMs
+       << " ms): " << clocks.describe("case", true) << "\n";
 }
 
 std::string fixed(double v, int prec) {
@@ -99,7 +113,8 @@ void add_step_bench(CLI::App& app, const char* name, const char* description, st
   o->reps = reps;
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
-  c->add_option("--reps", o->reps, "Timed steps")->check(CLI::PositiveNumber);
+  c->add_option("--reps", o->reps, "Timed steps (gl: at the least, more where they take under 200 ms)")
+      ->check(CLI::PositiveNumber);
   if (device == Device::gpu) add_warmup_ms(*c, *o);
   c->callback([o, run] { run(*o); });
 }

@@ -42,6 +42,12 @@ WarmUp warm_up_from_rest(Pipeline& p, const Model& m, double min_ms) {
   return w;
 }
 
+int steps_spanning(double ms, double step_ms, int min_steps, int multiple) {
+  const double n = std::max(double(std::max(min_steps, 1)), std::ceil(ms / std::max(step_ms, 1e-6)));
+  const double m = std::max(multiple, 1);
+  return int(std::min(std::ceil(n / m) * m, 1e6));
+}
+
 bool on_gpu(const PipelineEntry& e) { return e.traits.force != Engine::cpu || e.traits.update != Engine::cpu; }
 
 const char* to_string(Math m) { return m == Math::fast ? "fast" : "exact"; }

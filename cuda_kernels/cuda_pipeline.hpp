@@ -110,6 +110,7 @@ struct DeviceInfo {
   double memory_gib = 0;
   int cc_major = 0, cc_minor = 0;
   int driver_version = 0, runtime_version = 0;
+  std::string pci_bus_id;  // e.g. "0000:1B:00.0": which GPU a ClockWatch reads
 };
 DeviceInfo device_info();
 // Median GPU time of a device-to-device cudaMemcpy of `bytes`, ms (CUDA events, `reps` copies

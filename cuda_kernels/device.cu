@@ -53,6 +53,9 @@ DeviceInfo device_info() {
   d.cc_minor = p.minor;
   check(cudaDriverGetVersion(&d.driver_version), "querying the driver version");
   check(cudaRuntimeGetVersion(&d.runtime_version), "querying the runtime version");
+  char bus[32] = {};
+  check(cudaDeviceGetPCIBusId(bus, sizeof bus, dev), "querying the PCI bus id");
+  d.pci_bus_id = bus;
   return d;
 }
 

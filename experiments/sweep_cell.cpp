@@ -2,8 +2,10 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
+#include "core/clock_watch.hpp"
 #include "core/scene.hpp"
 #include "core/state.hpp"
 #include "core/node_order.hpp"
@@ -105,14 +107,14 @@ class CellSteps {
 // first carries one-time costs: shader compiles, first touches of the buffers). Returns why
 // the cell is cut, else "".
 constexpr int kBoundingSteps = 2;
-std::string cut_after_second_step(CellSteps& steps, const Sweep& s) {
+std::string cut_after_second_step(CellSteps& steps, const Sweep& s, int per_batch) {
   steps.step();
   steps.finish();
   const auto t0 = clock::now();
   steps.step();
   steps.finish();
   const double step_s = std::chrono::duration<double>(clock::now() - t0).count();
-  const double expect_s = step_s * (s.warmup + double(s.steps) * s.repetitions);
+  const double expect_s = step_s * (s.warmup + double(per_batch) * s.repetitions);
   if (expect_s <= s.cell_limit_s) return {};
   std::ostringstream os;
   os << "cut: the second step took " << step_s << " s, the cell would need about " << expect_s
@@ -120,23 +122,25 @@ std::string cut_after_second_step(CellSteps& steps, const Sweep& s) {
   return os.str();
 }
 
-// The rest of the warm-up, then ms per step of each timed batch: steps by `timer`, one of
-// the pipeline's step timers; frames (null timer: a step and its draw each) on the host clock,
-// from a drained device to a drained device.
-std::vector<double> timed_batches(Pipeline& pipe, StepTimer* timer, CellSteps& steps, const Sweep& s) {
+// The rest of the warm-up, then ms per step of each of s.repetitions timed batches of
+// `per_batch` steps: steps by `timer`, one of the pipeline's step timers, all back to back (the
+// batches cut from one timed run); frames (null timer: a step and its draw each) on the host
+// clock, from a drained device to a drained device.
+std::vector<double> timed_batches(Pipeline& pipe, StepTimer* timer, CellSteps& steps, const Sweep& s, int per_batch) {
   for (int w = kBoundingSteps; w < s.warmup; ++w) steps.step();
   steps.finish();
   std::vector<double> ms_per_step;
+  if (timer) {
+    const std::vector<double> ms = timed_steps(pipe, *timer, s.repetitions * per_batch);
+    for (auto b = ms.begin(); b != ms.end(); b += per_batch)
+      ms_per_step.push_back(std::accumulate(b, b + per_batch, 0.0) / double(per_batch));
+    return ms_per_step;
+  }
   for (int rep = 0; rep < s.repetitions; ++rep) {
-    if (timer) {
-      const std::vector<double> ms = timed_steps(pipe, *timer, s.steps);
-      ms_per_step.push_back(std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size()));
-      continue;
-    }
     const auto b0 = clock::now();
-    for (int st = 0; st < s.steps; ++st) steps.step();
+    for (int st = 0; st < per_batch; ++st) steps.step();
     steps.finish();
-    ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / s.steps);
+    ms_per_step.push_back(std::chrono::duration<double, std::milli>(clock::now() - b0).count() / per_batch);
   }
   return ms_per_step;
 }
@@ -160,30 +164,38 @@ json stage_times(Pipeline& pipe, CellSteps& steps, const Sweep& s) {
 }
 
 std::string method_of(const Sweep& s) {
-  const std::string batches = ", median of " + std::to_string(s.repetitions) + " batches of " +
-                              std::to_string(s.steps) + " after " + std::to_string(s.warmup) +
-                              " warm-up steps (pipelines with a GPU pass: after " +
-                              std::to_string(int(kGpuWarmUpMs)) + " ms of untimed steps from rest first)";
+  const std::string after = " after " + std::to_string(s.warmup) + " warm-up steps (pipelines with a GPU pass: after " +
+                            std::to_string(int(kGpuWarmUpMs)) + " ms of untimed steps from rest first)";
+  const std::string reps = std::to_string(s.repetitions), steps = std::to_string(s.steps);
   if (s.time == "frame")
     return "host steady_clock around each batch of frames (a step and a 1024 x 1024 draw each), from a drained "
-           "device to a drained device, ms per frame" + batches;
-  return "each step on its pipeline's step clock, ms per step (the batch's mean)" + batches;
+           "device to a drained device, ms per frame, median of " + reps + " batches of " + steps + after;
+  return "each step on its pipeline's step clock, ms per step (the batch's mean), median of " + reps +
+         " batches of at least " + steps + " steps, all timed back to back (pipelines with a GPU pass: about " +
+         std::to_string(int(kGpuTimedMs)) + " ms of steps in all; a cell's steps_per_batch)" + after;
 }
 
-// Times the cell on `pipe` from the rest state into `r`, or says why it was cut. Untimed steps
-// from rest for `warm_ms` (kGpuWarmUpMs on GPU pipelines) come first, as in `deformlab run`, so
-// that the steps that bound the cell and the timed ones run at the device's working clock.
-json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm_ms) {
+// Times the cell on `pipe` from the rest state into `r`, or says why it was cut. On a GPU
+// pipeline untimed steps from rest for kGpuWarmUpMs come first, as in `deformlab run`, so that
+// the steps that bound the cell and the timed ones run at the device's working clock, and the
+// GPU's clock is watched over the timed batches.
+json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, bool gpu) {
   CellSteps steps(pipe, m, s.time);
-  if (warm_ms > 0) {
+  int per_batch = s.steps;
+  if (gpu) {
     pipe.set_state(rest_state(m));
-    const WarmUp w = warm_up([&] { steps.step(); }, [&] { steps.finish(); }, warm_ms);
+    const WarmUp w = warm_up([&] { steps.step(); }, [&] { steps.finish(); }, kGpuWarmUpMs);
     r["warm_up"] = {{"steps", w.steps}, {"ms", w.ms}, {"clock", "host steady_clock"}};
+    if (s.time != "frame")
+      per_batch = steps_spanning(kGpuTimedMs / s.repetitions, w.ms / std::max(w.steps, 1), s.steps);
   }
   pipe.set_state(rest_state(m));
-  if (auto why = cut_after_second_step(steps, s); !why.empty()) return not_applicable(r, why);
+  if (auto why = cut_after_second_step(steps, s, per_batch); !why.empty()) return not_applicable(r, why);
   const std::unique_ptr<StepTimer> timer = s.time == "frame" ? nullptr : pipe.step_timer();
-  const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s);
+  std::optional<ClockWatch> watch;
+  if (gpu) watch.emplace();
+  const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s, per_batch);
+  const ClockSummary clock = watch ? watch->stop() : ClockSummary{};
   const double d = pipe.max_displacement();
   if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
   r["status"] = "ok";
@@ -194,7 +206,9 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, double warm
   r["pipeline_timing"] = pipe.timing_method();
   r["time"] = s.time;
   r["method"] = method_of(s);
+  r["steps_per_batch"] = per_batch;
   if (timer) r["step_clock"] = timer->clock();
+  if (gpu) r["sm_clock"] = to_json(clock);
   return r;
 }
 
@@ -221,7 +235,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
       if (auto why = record_mesh(m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
-    return measure(r, *pipe, m, s, on_gpu(e) ? kGpuWarmUpMs : 0.0);
+    return measure(r, *pipe, m, s, on_gpu(e));
   } catch (const std::invalid_argument& ex) {
     return not_applicable(r, ex.what());
   } catch (const std::bad_alloc&) {

@@ -48,6 +48,17 @@ TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
   EXPECT_EQ(std::vector<int>(batches.begin(), batches.begin() + 4), (std::vector<int>{1, 2, 4, 8}));
 }
 
+// The timed steps of a GPU case span about kGpuTimedMs: 0.106 ms steps 1887 of them, rounded up
+// to whole launches of 8; slow steps at least the count asked for; no step time, a bounded count.
+TEST(Pipelines, TimedStepsSpanTheirTime) {
+  EXPECT_EQ(steps_spanning(200, 0.106, 8, 8), 1888);
+  EXPECT_EQ(steps_spanning(200, 0.1, 8), 2000);
+  EXPECT_EQ(steps_spanning(200, 50, 20), 20);
+  EXPECT_EQ(steps_spanning(200, 50, 20, 8), 24);
+  EXPECT_EQ(steps_spanning(200, 300, 0), 1);
+  EXPECT_EQ(steps_spanning(200, 0, 1), 1000000);
+}
+
 // Option names and values are read before anything runs: a name the pipeline does not read,
 // and every value a backend built here cannot read, are refused with the pipeline's name.
 TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
