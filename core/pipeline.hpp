@@ -149,10 +149,10 @@ WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& d
 WarmUp warm_up_from_rest(Pipeline& p, const Model& m, double min_ms);
 inline constexpr double kGpuWarmUpMs = 1000.0;
 // Device time that a GPU pipeline's timed steps span at the least, back to back (no wait between
-// them) after the warm-up and the return to rest. Under a load near the GPU's power cap the first
-// tens of ms after a pause run slower (the H100 at 2048^2, cuda-fused in fast math: its first
-// 100-200 steps 1-3% slower than the rest), and steps timed in short batches with a wait after
-// each ran 5% slower throughout, at an SM clock of 1500 MHz against 1965 (docs/speed.md).
+// them) after the warm-up and the return to rest, as a run's are. On the H100 at 2048^2 in fast
+// math cuda-fused's first 100-200 steps after the pause took up to 3% longer than the rest, and
+// steps timed in batches of about 1 ms with a wait after each took 1-17% longer throughout
+// (docs/speed.md, the bench and the run in fast math).
 inline constexpr double kGpuTimedMs = 200.0;
 // Steps that span about `ms` at `step_ms` a step: at least `min_steps` (from 1), rounded up to a
 // multiple of `multiple` (cuda-temporal's launches of up to 8 steps whole).
