@@ -6,6 +6,8 @@
 #include <chrono>
 #include <sstream>
 
+#include "profiler.hpp"
+
 namespace deformlab {
 
 namespace {
@@ -26,6 +28,11 @@ constexpr Slowdown kSlowdowns[] = {{0x4, "power cap"},
 
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// "power cap in 25%": the slowdowns seen and the share of samples with one.
+std::string slowed_share(const ClockSummary& s) {
+  return slowdown_names(s.reasons) + " in " + std::to_string(int(100 * s.slowed + 0.5)) + "%";
 }
 
 }  // namespace
@@ -83,12 +90,8 @@ std::string describe(const ClockSummary& s) {
   if (!s.watched()) return "SM clock not read (no NVIDIA driver's NVML here)";
   std::ostringstream os;
   os << "SM clock " << s.sm_mhz_min << "-" << s.sm_mhz_max << " MHz (median " << s.sm_mhz_median << ", top "
-     << s.sm_mhz_top << "); ";
-  if (s.slowed > 0)
-    os << slowdown_names(s.reasons) << " in " << int(s.slowed * 100 + 0.5) << "%";
-  else
-    os << "no slowdown in any";
-  os << " of " << s.samples << " samples (NVML, every " << ClockWatch::kPeriodMs << " ms, " << s.device << ")";
+     << s.sm_mhz_top << "); " << (s.slowed > 0 ? slowed_share(s) : "no slowdown in any") << " of " << s.samples
+     << " samples (NVML, every " << ClockWatch::kPeriodMs << " ms, " << s.device << ")";
   return os.str();
 }
 
@@ -126,8 +129,8 @@ void ClockTally::add(const std::string& label, const ClockSummary& c) {
   lo_ = std::min(lo_, c.sm_mhz_median);
   hi_ = std::max(hi_, c.sm_mhz_median);
   if (c.slowed > 0)
-    slowed_.push_back(label + " (" + slowdown_names(c.reasons) + " in " + std::to_string(int(100 * c.slowed + 0.5)) +
-                      "% of samples, " + std::to_string(c.sm_mhz_min) + "-" + std::to_string(c.sm_mhz_max) + " MHz)");
+    slowed_.push_back(label + " (" + slowed_share(c) + " of samples, " + std::to_string(c.sm_mhz_min) + "-" +
+                      std::to_string(c.sm_mhz_max) + " MHz)");
 }
 
 std::string ClockTally::describe(const std::string& noun, bool one_per_line) const {
@@ -199,17 +202,17 @@ ClockSummary ClockWatch::stop() {
   sum.device = name_;
   sum.samples = int(all.size());
   sum.sm_mhz_top = top_mhz_;
-  std::vector<unsigned> mhz;
+  std::vector<double> mhz;
   int slowed = 0;
   for (const ClockSample& s : all) {
     mhz.push_back(s.sm_mhz);
     sum.reasons |= s.reasons;
     slowed += s.reasons != 0;
   }
-  std::sort(mhz.begin(), mhz.end());
-  sum.sm_mhz_min = mhz.front();
-  sum.sm_mhz_max = mhz.back();
-  sum.sm_mhz_median = mhz[mhz.size() / 2];
+  const auto [lo, hi] = std::minmax_element(mhz.begin(), mhz.end());
+  sum.sm_mhz_min = unsigned(*lo);
+  sum.sm_mhz_max = unsigned(*hi);
+  sum.sm_mhz_median = unsigned(median(mhz));
   sum.slowed = double(slowed) / double(all.size());
   return sum;
 }

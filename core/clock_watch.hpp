@@ -1,6 +1,6 @@
 // ClockWatch: the GPU's SM clock while timed work runs, and what held it down. A GPU under
-// sustained load lowers its clock at its power cap (the H100 at 700 W: 1980 MHz down to about
-// 1485), so one scene timed twice can differ by the clock alone; a time shown with its clock
+// sustained load lowers its clock at its power cap (the H100 at 700 W: 1980 MHz down to as low
+// as 1410), so one scene timed twice can differ by the clock alone; a time shown with its clock
 // says which. Read through NVML, the driver's management library, loaded at run time: there
 // is no build or link dependency, and where the driver is absent the watch has no samples.
 #pragma once
@@ -38,7 +38,7 @@ struct ClockSummary {
 };
 
 // One line for a user: "SM clock 1485-1980 MHz (median 1980, top 1980); power cap in 12% of
-// 41 samples (NVML, every 5 ms)", or why there is none.
+// 41 samples (NVML, every 5 ms, DEVICE)", or why there is none.
 std::string describe(const ClockSummary& s);
 // For manifests and cells: the summary's fields, the slowdowns by name and what the clock is;
 // null where nothing was watched.
