@@ -9,6 +9,7 @@
 #include "core/clock_watch.hpp"
 #include "core/pipeline.hpp"
 #include "core/scene.hpp"
+#include "core/timed_work.hpp"
 
 namespace deformlab::bench {
 
@@ -36,7 +37,11 @@ struct Stats {
   ClockSummary clock;  // not watched on the CPU
 };
 Stats stats(std::vector<double> ms);
-double mean(const std::vector<double>& ms);
+Stats stats(const TimedWork& w);  // with w's clock
+
+// A CSV row's last two columns: the median SM clock (MHz) and the share of samples slowed; empty
+// where the clock was not watched.
+std::string clock_columns(const ClockSummary& c);
 
 // A bench's last line: the GPU's clock over its cases' `timed` ("timed steps", ...).
 void print_clocks(std::ostream& os, const ClockTally& clocks, const std::string& timed);

@@ -22,7 +22,6 @@ struct CudaOptions : BenchOptions {
   std::vector<std::string> tiles{"8x8", "16x8", "16x16", "32x4", "32x8", "32x16", "64x4", "128x2", "256x1"};
   int tile_size = 2048;
   std::vector<int> graph_sizes{64, 128, 256, 512};
-  int batches = 15;
   int copy_mib = 1024;
   double reference_ms = 0.48;
   std::vector<int> temporal_sizes{2048, 8192};
@@ -43,17 +42,13 @@ std::string fused_block(Math m) {
 }
 
 // Median ms per step from the rest state: the warm-up (warm_up_from_rest, then o.warmup steps),
-// then steps back to back for about kGpuTimedMs (a multiple of 8, so that cuda-temporal's
-// launches are whole), each on the pipeline's step clock (CUDA events), as `deformlab run` times
-// its steps; the GPU `bus` watched over them.
+// then steps back to back for about kGpuTimedMs (time_back_to_back; a multiple of 8, so that
+// cuda-temporal's launches are whole), each on the pipeline's step clock (CUDA events), as
+// `deformlab run` times its steps; the GPU `bus` watched over them.
 Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o, const std::string& bus) {
   warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
-  const double warm = mean(timed_steps(p, *timer, o.warmup));
-  ClockWatch watch(bus);
-  Stats s = stats(timed_steps(p, *timer, steps_spanning(kGpuTimedMs, warm, 8, 8)));
-  s.clock = watch.stop();
-  return s;
+  return stats(time_back_to_back(*timer, [&] { p.step(); }, o.warmup, 8, bus, 8));
 }
 
 struct Row {
@@ -61,7 +56,7 @@ struct Row {
   bool graphs;
   std::int64_t nodes;
   double ms, floor_bytes, gbs, of_copy;
-  ClockSummary clock;  // over the timed steps; not watched for the bare gather
+  ClockSummary clock;  // over the timed steps or launches
 };
 
 class Report {
@@ -96,7 +91,7 @@ class Report {
     return record(r, k);
   }
 
-  const ClockTally& clocks() const { return clocks_; }
+  ClockTally& clocks() { return clocks_; }
 
   // The bare gather (cuda::bare_gather_ms) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
@@ -116,8 +111,11 @@ class Report {
     r.math = "none";
     r.graphs = false;
     r.nodes = std::int64_t(n) * n;
-    r.ms = cuda::bare_gather_ms(n, tile, damped, verlet, o.batches, o.warmup_ms);
+    const TimedWork w = cuda::time_bare_gather(n, tile, damped, verlet, o.warmup_ms);
+    r.ms = w.median_ms();
+    r.clock = w.clock;
     r.floor_bytes = verlet ? 80 : 64;
+    clocks_.add("bare gather " + r.grid + " " + r.scene + " " + r.integrator, w.clock);
     return record(r, 1);
   }
 
@@ -129,8 +127,7 @@ class Report {
       csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator
            << "," << r.tile << "," << r.math << "," << steps_per_launch << "," << r.graphs << "," << r.ms << ","
            << r.floor_bytes << "," << r.gbs << "," << r.of_copy << ","
-           << (r.clock.watched() ? std::to_string(r.clock.sm_mhz_median) : "") << ","
-           << (r.clock.watched() ? std::to_string(r.clock.slowed) : "") << "\n";
+           << clock_columns(r.clock) << "\n";
     return r;
   }
 
@@ -152,24 +149,26 @@ void run_cuda(const CudaOptions& o) {
 
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
-  const double copy = cuda::copy_ms(copy_bytes, 20, o.warmup_ms);
+  const TimedWork copy_work = cuda::time_copy(copy_bytes, 20, o.warmup_ms);
+  const double copy = copy_work.median_ms();
   const double copy_gbs = 2.0 * double(copy_bytes) / (copy * 1e-3) / 1e9;
   std::cout << "deformlab-bench cuda: " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
-            << "method: CUDA events around each step (the pipeline's step clock) after " << warm_up_words(o)
+            << "method: a CUDA event at each step's end (the pipeline's step clock) after " << warm_up_words(o)
             << o.warmup << " warm-up steps; the median of steps timed back to back for about "
             << fixed(kGpuTimedMs, 0) << " ms (at least 8), in ms per step.\n"
             << "cloth grid n x n, 12 springs per interior node. " << describe(kind) << ";\n"
             << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
             << "floor: compulsory DRAM bytes per node per step (each array a kernel touches read or written\n"
             << "once, neighbours from cache); effective GB/s = floor x nodes / time; copy = cudaMemcpy device to\n"
-            << "device of " << o.copy_mib << " MiB"
+            << "device of " << o.copy_mib << " MiB, timed as the steps are"
             << (o.warmup_ms > 0 ? " (after " + fixed(o.warmup_ms, 0) + " ms of copies)" : "") << ", "
             << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
   Report rep(o, copy_gbs, dev.pci_bus_id);
+  rep.clocks().add("copy " + std::to_string(o.copy_mib) + " MiB", copy_work.clock);
   std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", exact math, default tiles, step "
                "graphs on\n"
             << std::setw(8) << "grid" << std::setw(10) << "variant" << std::setw(12) << "ms/step" << std::setw(10)
@@ -222,10 +221,9 @@ void run_cuda(const CudaOptions& o) {
               << "(block " << fused_block(Math::fast) << ", cuda-fused's in fast math): "
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
-              << "the fastest of 1, 2 or 4 neighbours' loads at a time, each the median of " << o.batches
-              << " batches of 10 launches after "
+              << "the fastest of 1, 2 or 4 neighbours' loads at a time, each timed as the steps are (after "
               << (o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of launches and " : "")
-              << "10 warm-up launches (CUDA events); a reference, not a bound "
+              << "10 warm-up launches); a reference, not a bound "
               << "(cuda-fused's L2 prefetch can beat it)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
@@ -288,7 +286,7 @@ void run_cuda(const CudaOptions& o) {
         }
     }
   }
-  print_clocks(std::cout, rep.clocks(), "timed steps");
+  print_clocks(std::cout, rep.clocks(), "timed steps or launches");
 }
 
 }  // namespace
@@ -306,8 +304,6 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--tiles", o->tiles, "Tile shapes WxH for the sweep");
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
-  c->add_option("--batches", o->batches, "The bare gather's timed batches (the median is reported)")
-      ->check(CLI::PositiveNumber);
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
       ->check(CLI::PositiveNumber);
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");

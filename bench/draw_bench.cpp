@@ -5,6 +5,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 
 #include "bench.hpp"
 #include "experiments/pipelines.hpp"
@@ -31,7 +32,8 @@ void run_draw(const StepOptions& o) {
             << " warm-up frames, ms.\n\n"
             << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(22) << "route" << std::setw(11)
             << "frame ms" << std::setw(10) << "draw ms" << "\n";
-  std::ofstream csv = open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms");
+  std::ofstream csv = open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms,sm_mhz_median,slowed_fraction");
+  ClockTally clocks;
   const std::pair<const char*, Route> cases[] = {{"glsl-compute", Route::own_buffer},
                                                  {"hybrid-compute", Route::own_buffer},
                                                  {"cuda-fused", Route::interop},
@@ -51,7 +53,9 @@ void run_draw(const StepOptions& o) {
       std::unique_ptr<interop::GlPositions> bridge;
       if (route == Route::interop) bridge = std::make_unique<interop::GlPositions>(scene.model.node_count());
       std::vector<double> frame_ms;
+      std::optional<ClockWatch> watch;
       for (int k = 0; k < o.warmup + o.reps; ++k) {
+        if (k == o.warmup) watch.emplace();
         p->max_displacement();  // drains the pipeline's work
         glFinish();
         const auto t0 = std::chrono::steady_clock::now();
@@ -65,11 +69,16 @@ void run_draw(const StepOptions& o) {
       const std::vector<double> draws = r.take_draw_ms();
       const double draw = stats(std::vector<double>(draws.end() - o.reps, draws.end())).median;
       const double frame = stats(frame_ms).median;
+      const ClockSummary clock = watch->stop();
+      clocks.add(std::to_string(n) + "^2 " + name + " " + to_string(route), clock);
       std::cout << std::setw(6) << n << std::setw(16) << name << std::setw(22) << to_string(route) << std::setw(11)
                 << fixed(frame, 3) << std::setw(10) << fixed(draw, 3) << std::endl;
-      if (csv) csv << n << "," << name << "," << to_string(route) << "," << frame << "," << draw << "\n";
+      if (csv)
+        csv << n << "," << name << "," << to_string(route) << "," << frame << "," << draw << "," << clock_columns(clock)
+            << "\n";
     }
   }
+  print_clocks(std::cout, clocks, "timed frames");
 }
 
 }  // namespace

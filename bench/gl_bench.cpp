@@ -17,29 +17,11 @@ namespace deformlab::bench {
 
 namespace {
 
-// Timed steps after o.warmup more: back to back for about kGpuTimedMs, o.reps at the least.
-int timed_count(const std::vector<double>& warm_ms, const StepOptions& o) {
-  return steps_spanning(kGpuTimedMs, mean(warm_ms), o.reps);
-}
-
-// `work` timed on `timer` (after `prepare`, untimed, each time) o.warmup times, then timed_count
-// times back to back; the GPU's clock over the latter.
-Stats time_work(gl::Timer& timer, const std::function<void()>& prepare, const std::function<void()>& work,
-                const StepOptions& o) {
-  const auto timed = [&](int steps) {
-    for (int w = 0; w < steps; ++w) {
-      prepare();
-      timer.begin();
-      work();
-      timer.end();
-    }
-    return timer.take();
-  };
-  const int steps = timed_count(timed(o.warmup), o);
-  ClockWatch watch;
-  Stats s = stats(timed(steps));
-  s.clock = watch.stop();
-  return s;
+// `work` on GL timer queries (after `prepare`, untimed, each time) as the steps are timed
+// (time_back_to_back: o.warmup calls, then about kGpuTimedMs of them, o.reps at the least).
+Stats time_work(const std::function<void()>& prepare, const std::function<void()>& work, const StepOptions& o) {
+  gl::QueryStepTimer timer;
+  return stats(time_back_to_back(timer, work, o.warmup, o.reps, {}, 1, prepare));
 }
 
 // GPU ms per step of a GL pipeline, each step on its step clock after the warm-up; the GPU's
@@ -47,10 +29,7 @@ Stats time_work(gl::Timer& timer, const std::function<void()>& prepare, const st
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   warm_up_from_rest(p, m, o.warmup_ms);
   const auto timer = p.step_timer();
-  const int n = timed_count(timed_steps(p, *timer, o.warmup), o);
-  ClockWatch watch;
-  Stats s = stats(timed_steps(p, *timer, n));
-  s.clock = watch.stop();
+  const Stats s = stats(time_back_to_back(*timer, [&] { p.step(); }, o.warmup, o.reps));
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
   return s;
 }
@@ -84,7 +63,6 @@ Stats time_passthrough(int n, const StepOptions& o) {
     for (GLuint a = 0; a < 2; ++a) glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, a, buf[s][a].id());
   }
   glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
-  Timer timer;
   glUseProgram(prog.id());
   glEnable(GL_RASTERIZER_DISCARD);
   int k = 0;
@@ -97,7 +75,7 @@ Stats time_passthrough(int n, const StepOptions& o) {
     glEndTransformFeedback();
   };
   warm_up(copy, glFinish, o.warmup_ms);
-  const Stats s = time_work(timer, [] {}, copy, o);
+  const Stats s = time_work([] {}, copy, o);
   glDisable(GL_RASTERIZER_DISCARD);
   glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
   glBindVertexArray(0);
@@ -116,7 +94,6 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   Buffer buf[2][3];
   for (auto& state : buf)
     for (Buffer& b : state) b = make_buffer(rest.size() * sizeof(float), rest.data());
-  Timer timer;
   glUseProgram(prog.id());
   glUniform1i(0, n);
   int k = 0;
@@ -138,7 +115,7 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
         dispatch();
       },
       glFinish, o.warmup_ms);
-  const Stats s = time_work(timer, bind, dispatch, o);
+  const Stats s = time_work(bind, dispatch, o);
   glUseProgram(0);
   check("the bare gather");
   return s;
@@ -199,8 +176,7 @@ void run_gl(const StepOptions& o) {
       if (csv)
         csv << '"' << ctx.renderer << "\"," << n << "x" << n << "," << m.node_count() << "," << what << ","
             << s.median << "," << s.min << "," << s.p90 << ","
-            << (s.clock.watched() ? std::to_string(s.clock.sm_mhz_median) : "") << ","
-            << (s.clock.watched() ? std::to_string(s.clock.slowed) : "") << "\n";
+            << clock_columns(s.clock) << "\n";
     }
   }
   print_clocks(std::cout, clocks, "timed steps");

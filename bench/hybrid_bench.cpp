@@ -21,7 +21,7 @@ namespace {
 struct HybridOptions : BenchOptions {
   std::vector<std::string> modes{"map", "external", "external-gpusync", "staged"};
   std::vector<std::string> updates{"tf", "compute"};
-  int steps = 20;
+  int steps = 20;  // timed steps at the least
   double floor_us = NAN;  // the calibrated floor; measured here when unset and external-gpusync is swept
   bool baselines = true;  // also time cuda-fused and glsl-tf
 };
@@ -37,6 +37,7 @@ struct Row {
   double hand_off_host_us = NAN;  // per step: host clock inside hand-off calls
   double hand_off_us = NAN;  // per hand-off: (wall - force - update) / hand-offs
   int hand_offs = 0;         // per step
+  ClockSummary clock;        // over the steps timed on the step clock
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -58,10 +59,11 @@ std::pair<double, double> timed(Pipeline& p, int steps, Profiler* prof) {
   return {ms_since(t0) / steps, host / steps};
 }
 
-// Median ms per step of `steps` steps on the pipeline's step clock.
-double step_clock_ms(Pipeline& p, int steps) {
+// The pipeline's step clock over steps back to back for about kGpuTimedMs after `warmup` more
+// (time_back_to_back, `min_steps` at the least), the GPU `bus` watched.
+TimedWork step_clock(Pipeline& p, int warmup, int min_steps, const std::string& bus) {
   const auto timer = p.step_timer();
-  return median(timed_steps(p, *timer, steps));
+  return time_back_to_back(*timer, [&] { p.step(); }, warmup, min_steps, bus);
 }
 
 double stage_ms(const Profiler& prof, const char* name) {
@@ -78,23 +80,26 @@ void run_hybrid(const HybridOptions& o) {
   // The floor's ping-pong does no work: copies for o.warmup_ms raise the device's clock first, as
   // the cases' warm-ups do.
   const bool measure_floor = std::isnan(o.floor_us) && gpusync;
-  if (measure_floor) cuda::copy_ms(std::int64_t(256) << 20, 1, o.warmup_ms);
+  if (measure_floor) cuda::time_copy(std::int64_t(256) << 20, 1, o.warmup_ms);
   const double floor_us = measure_floor ? interop::hand_off_floor_us(2000) : o.floor_us;
   const int passes = info(integ).force_passes;
   const SceneKind kind = o.scene_kind();
   std::cout << "deformlab-bench hybrid: CUDA device " << dev << ", GL " << ctx.renderer << "\n"
             << "cloth n x n, " << describe(kind) << "; " << o.integrator << ", " << warm_up_words(o)
-            << o.warmup << " warm-up steps, then " << o.steps << " timed steps.\n"
-            << "wall: host clock over the timed steps, drained at the end, per step. host: host clock inside step().\n"
-            << "gpu: the pipeline's step clock, median per step of " << o.steps << " more steps (CUDA events for\n"
-            << "cuda-fused; GL timer queries for glsl-tf and the hybrids, whose GL update waits for the CUDA\n"
-            << "forces). force: CUDA events;\n"
+            << o.warmup << " warm-up steps.\n"
+            << "gpu: the pipeline's step clock, median per step of steps back to back for about "
+            << fixed(kGpuTimedMs, 0) << " ms (at least\n"
+            << o.steps << "; CUDA events for cuda-fused, GL timer queries for glsl-tf and the hybrids, whose GL update\n"
+            << "waits for the CUDA forces), as `deformlab run` times its steps. Then as many steps again:\n"
+            << "wall: host clock over them, drained at the end, per step. host: host clock inside step().\n"
+            << "force: CUDA events;\n"
             << "update: GL timer queries (median per step). hand-off: (wall - force - update) / hand-offs per step\n"
             << "(" << 2 * passes << "); ho-host: host clock inside the hand-off calls per step. floor: GL<->CUDA\n"
             << "semaphore ping-pong with no work, " << fixed(floor_us, 1) << " us per hand-off. bound: wall <= 1.05 x\n"
             << "(update + force + " << 2 * passes << " floors).\n\n";
   std::ofstream csv = open_csv(
-      o.csv, "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us");
+      o.csv, "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us,"
+         "sm_mhz_median,slowed_fraction");
   std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
             << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
             << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)
@@ -110,33 +115,35 @@ void run_hybrid(const HybridOptions& o) {
     if (csv)
       csv << r.n << "," << r.pipeline << "," << r.mode << "," << r.wall_ms << "," << r.host_ms << "," << r.gpu_ms << ","
           << r.force_ms << "," << r.update_ms << "," << r.hand_off_us << "," << r.hand_off_host_us << "," << floor_us
-          << "\n";
+          << "," << clock_columns(r.clock) << "\n";
   };
 
+  const std::string bus = cuda::device_info(dev).pci_bus_id;
+  ClockTally clocks;
+  // Times `p` into `r`: the step clock, then as many steps on the host clock, with `prof` where
+  // given (the stage split).
+  auto measure = [&](Pipeline& p, const Model& m, Row& r, Profiler* prof) {
+    warm_up_from_rest(p, m, o.warmup_ms);
+    const TimedWork g = step_clock(p, o.warmup, o.steps, bus);
+    r.gpu_ms = g.median_ms();
+    r.clock = g.clock;
+    clocks.add(std::to_string(r.n) + "^2 " + r.pipeline + (r.mode == "-" ? "" : " " + r.mode), g.clock);
+    p.set_profiler(prof);
+    std::tie(r.wall_ms, r.host_ms) = timed(p, int(g.ms.size()), prof);
+    p.set_profiler(nullptr);
+  };
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
     if (o.baselines) {
-      auto p = cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true});
-      warm_up_from_rest(*p, m, o.warmup_ms);
-      for (int s = 0; s < o.warmup; ++s) p->step();
-      Row r{n, "cuda-fused", "-"};
-      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, nullptr);
-      r.gpu_ms = step_clock_ms(*p, o.steps);
-      print(r);
-    }
-    if (o.baselines) {
-      auto p = gl::make_tf_pipeline(setup);
-      warm_up_from_rest(*p, m, o.warmup_ms);
-      for (int s = 0; s < o.warmup; ++s) p->step();
-      Row r{n, "glsl-tf", "-"};
+      Row fused{n, "cuda-fused", "-"};
+      measure(*cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true}), m, fused, nullptr);
+      print(fused);
+      Row tf{n, "glsl-tf", "-"};
       Profiler prof;
-      p->set_profiler(&prof);
-      std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, &prof);
-      p->set_profiler(nullptr);
-      r.gpu_ms = step_clock_ms(*p, o.steps);
-      print(r);
+      measure(*gl::make_tf_pipeline(setup), m, tf, &prof);
+      print(tf);
     }
     for (const auto& u : o.updates)
       for (const auto& mode_name : o.modes) {
@@ -151,21 +158,17 @@ void run_hybrid(const HybridOptions& o) {
         auto p = interop::make_hybrid_pipeline(
             setup, {u == "compute" ? interop::Update::compute : interop::Update::transform_feedback, *mode,
                     cuda::Variant::naive});
-        warm_up_from_rest(*p, m, o.warmup_ms);
-        for (int s = 0; s < o.warmup; ++s) p->step();
         Profiler prof;
-        p->set_profiler(&prof);
-        std::tie(r.wall_ms, r.host_ms) = timed(*p, o.steps, &prof);
-        p->set_profiler(nullptr);
+        measure(*p, m, r, &prof);
         r.force_ms = stage_ms(prof, span::force);
         r.update_ms = stage_ms(prof, span::update);
         r.hand_off_host_us = stage_ms(prof, span::hand_off) * 1e3;
         r.hand_offs = 2 * passes;
         r.hand_off_us = (r.wall_ms - r.force_ms - r.update_ms) * 1e3 / r.hand_offs;
-        r.gpu_ms = step_clock_ms(*p, o.steps);
         print(r);
       }
   }
+  print_clocks(std::cout, clocks, "steps timed on the step clock");
 }
 
 }  // namespace
@@ -179,7 +182,8 @@ void add_hybrid_bench(CLI::App& app) {
   add_warmup_ms(*c, *o);
   c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
   c->add_option("--updates", o->updates, "Update passes: tf, compute");
-  c->add_option("--steps", o->steps, "Timed steps")->check(CLI::PositiveNumber);
+  c->add_option("--steps", o->steps, "Timed steps at the least (more where they take under 200 ms)")
+      ->check(CLI::PositiveNumber);
   c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
   c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
   c->callback([o] { run_hybrid(*o); });

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <iomanip>
 #include <memory>
-#include <numeric>
 #include <sstream>
 
 #include "bench.hpp"
@@ -52,8 +51,14 @@ Stats stats(std::vector<double> ms) {
   return {median(ms), ms.front(), ms[std::min(ms.size() - 1, ms.size() * 9 / 10)]};
 }
 
-double mean(const std::vector<double>& ms) {
-  return ms.empty() ? 0.0 : std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size());
+Stats stats(const TimedWork& w) {
+  Stats s = stats(w.ms);
+  s.clock = w.clock;
+  return s;
+}
+
+std::string clock_columns(const ClockSummary& c) {
+  return c.watched() ? std::to_string(c.sm_mhz_median) + "," + std::to_string(c.slowed) : ",";
 }
 
 void print_clocks(std::ostream& os, const ClockTally& clocks, const std::string& timed) {

@@ -11,6 +11,10 @@
 struct float4;
 struct CUstream_st;
 
+namespace deformlab {
+struct TimedWork;  // core/timed_work.hpp
+}
+
 namespace deformlab::cuda {
 
 enum class Variant {
@@ -112,18 +116,18 @@ struct DeviceInfo {
   int driver_version = 0, runtime_version = 0;
   std::string pci_bus_id;  // e.g. "0000:1B:00.0": which GPU a ClockWatch reads
 };
-DeviceInfo device_info();
-// Median GPU time of a device-to-device cudaMemcpy of `bytes`, ms (CUDA events, `reps` copies
-// after copies for `warm_ms` (warm_up) and one more).
-double copy_ms(std::int64_t bytes, int reps, double warm_ms);
+DeviceInfo device_info(int device = -1);  // -1: the current device
+// A device-to-device cudaMemcpy of `bytes`, timed as the steps are (time_back_to_back: copies
+// back to back for about kGpuTimedMs, `min_reps` at the least, each ended by a CUDA event, after
+// copies for `warm_ms` (warm_up) and 3 more), with the device's clock over them.
+TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms);
 // The bare gather: cuda-fused's loads and stores on an n x n cloth without its arithmetic
 // (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs); the
 // previous positions with `previous` (Verlet)), on blocks of `tile`: the fastest of three load
-// schedules (1, 2 or 4 neighbours' loads at a time), each the median over `batches` batches of
-// 10 launches after launches for `warm_ms` (warm_up) and 10 more, ms per launch (CUDA events).
-// A reference for the gather's memory traffic, not a bound: cuda-fused's L2 prefetch, which it
-// lacks, can beat it.
-double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches, double warm_ms);
+// schedules (1, 2 or 4 neighbours' loads at a time) by median, each timed as time_copy's copies
+// (after launches for `warm_ms` and 10 more). A reference for the gather's memory traffic, not a
+// bound: cuda-fused's L2 prefetch, which it lacks, can beat it.
+TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, double warm_ms);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.
 double floor_bytes_per_node(const Model& m, Integrator i, const Options& o);

@@ -1,7 +1,5 @@
 // Device discovery, memory checks and the benchmarks' references: the copy bandwidth and the
 // bare gather.
-#include <algorithm>
-#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <type_traits>
@@ -9,7 +7,9 @@
 
 #include "check.cuh"
 #include "core/grid_stencil.hpp"
+#include "core/timed_work.hpp"
 #include "cuda_pipeline.hpp"
+#include "event_spans.hpp"
 
 namespace deformlab::cuda {
 
@@ -40,10 +40,10 @@ void require_device_memory(std::int64_t bytes, const std::string& what) {
                                 std::to_string(free) + " of " + std::to_string(total) + " bytes are free");
 }
 
-DeviceInfo device_info() {
+DeviceInfo device_info(int device) {
   DeviceInfo d;
-  int dev = 0;
-  check(cudaGetDevice(&dev), "querying the current device");
+  int dev = device;
+  if (dev < 0) check(cudaGetDevice(&dev), "querying the current device");
   cudaDeviceProp p{};
   check(cudaGetDeviceProperties(&p, dev), "querying device properties");
   d.name = p.name;
@@ -61,29 +61,16 @@ DeviceInfo device_info() {
 
 namespace {
 
-// The median over `batches` batches of `per_batch` calls of `work`, each batch timed by a pair
-// of CUDA events on the default stream after calls for `warm_ms` (warm_up) and `warmup` calls
-// more: ms per call. `what` names the work.
+// `work` on the default stream timed as the steps are (time_back_to_back: one event at each
+// call's end, as EventStepTimer times steps), after calls for `warm_ms` (warm_up) and `warmup`
+// more; the current device's clock watched. `what` names the work.
 template <class Work>
-double median_event_ms(double warm_ms, int warmup, int batches, int per_batch, Work&& work, const std::string& what) {
+TimedWork time_launches(double warm_ms, int warmup, int min_calls, Work&& work, const std::string& what) {
   warm_up(work, [&] { check(cudaDeviceSynchronize(), ("warming up " + what).c_str()); }, warm_ms);
-  for (int w = 0; w < warmup; ++w) work();
   check_launch(("starting " + what).c_str());
-  cudaEvent_t e[2];
-  for (cudaEvent_t& ev : e) check(cudaEventCreate(&ev), "creating a timing event");
-  std::vector<double> ms;
-  for (int b = 0; b < batches; ++b) {
-    check(cudaEventRecord(e[0]), "recording a timing event");
-    for (int l = 0; l < per_batch; ++l) work();
-    check(cudaEventRecord(e[1]), "recording a timing event");
-    check(cudaEventSynchronize(e[1]), ("running " + what).c_str());
-    float t = 0.f;
-    check(cudaEventElapsedTime(&t, e[0], e[1]), "reading a timing event");
-    ms.push_back(double(t) / per_batch);
-  }
-  for (cudaEvent_t ev : e) cudaEventDestroy(ev);
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  std::int64_t launched = 0;
+  EventStepTimer timer(nullptr, &launched, [] {});
+  return time_back_to_back(timer, [&] { work(), ++launched; }, warmup, min_calls, device_info().pci_bus_id);
 }
 
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
@@ -123,18 +110,18 @@ __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* _
 
 }  // namespace
 
-double copy_ms(std::int64_t bytes, int reps, double warm_ms) {
+TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms) {
   require_device_memory(2 * bytes, "the copy benchmark");
   Buffer<char> a, b;
   a.allocate(std::size_t(bytes), "allocating the copy source");
   b.allocate(std::size_t(bytes), "allocating the copy destination");
   check(cudaMemset(a.get(), 1, std::size_t(bytes)), "filling the copy source");
-  return median_event_ms(warm_ms, 1, reps, 1, [&] {
+  return time_launches(warm_ms, 3, min_reps, [&] {
     check(cudaMemcpyAsync(b.get(), a.get(), std::size_t(bytes), cudaMemcpyDeviceToDevice), "copying device memory");
   }, "the copy");
 }
 
-double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batches, double warm_ms) {
+TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, double warm_ms) {
   const std::int64_t nodes = std::int64_t(n) * n;
   require_device_memory((previous ? 5 : 4) * nodes * std::int64_t(sizeof(float4)), "the bare gather");
   Buffer<float4> x, v, xp, xo, vo;
@@ -153,12 +140,14 @@ double bare_gather_ms(int n, Tile tile, bool velocities, bool previous, int batc
     return velocities ? (previous ? bare_gather<true, true, g> : bare_gather<true, false, g>)
                       : (previous ? bare_gather<false, true, g> : bare_gather<false, false, g>);
   };
-  double best = std::numeric_limits<double>::infinity();
+  TimedWork best;
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
-                              pick(std::integral_constant<int, 4>{})})
-    best = std::min(best, median_event_ms(warm_ms, 10, batches, 10, [&] {
+                              pick(std::integral_constant<int, 4>{})}) {
+    TimedWork w = time_launches(warm_ms, 10, 10, [&] {
       kernel<<<blocks, threads>>>(n, x.get(), v.get(), xp.get(), xo.get(), vo.get());
-    }, "the bare gather"));
+    }, "the bare gather");
+    if (best.ms.empty() || w.median_ms() < best.median_ms()) best = std::move(w);
+  }
   return best;
 }
 

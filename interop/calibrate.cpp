@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/timed_work.hpp"
 #include "cuda_kernels/check.cuh"
 #include "cuda_kernels/cuda_pipeline.hpp"
 #include "gl/context.hpp"
@@ -22,17 +23,18 @@ double since_ms(clock_type::time_point t0) {
   return std::chrono::duration<double, std::milli>(clock_type::now() - t0).count();
 }
 
-// GL work timed per repetition (GL timer queries, or the host clock on a software driver).
+// GL work timed as the steps are (time_back_to_back on GL timer queries, or the host clock on a
+// software driver): `reps` calls at the least, after 3.
 template <class F>
-double gl_median_ms(int reps, F&& work) {
-  gl::Timer timer;
-  work();  // warm-up
-  for (int r = 0; r < reps; ++r) {
-    timer.begin();
-    work();
-    timer.end();
-  }
-  return median(timer.take());
+TimedWork gl_timed(int reps, F&& work) {
+  gl::QueryStepTimer timer;
+  return time_back_to_back(timer, work, 3, reps);
+}
+
+// How `w` was timed on `clock`, for the JSON.
+std::string method_words(const std::string& clock, const TimedWork& w) {
+  return clock + ", median of " + std::to_string(w.ms.size()) + " back to back (about " +
+         std::to_string(int(kGpuTimedMs)) + " ms)";
 }
 
 nlohmann::json tf_rate(std::int64_t n, int reps) {
@@ -57,7 +59,7 @@ nlohmann::json tf_rate(std::int64_t n, int reps) {
   glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, out_x.id());
   glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 1, out_v.id());
   glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
-  const double ms = gl_median_ms(reps, [&] {
+  const TimedWork w = gl_timed(reps, [&] {
     glUseProgram(prog.id());
     glEnable(GL_RASTERIZER_DISCARD);
     glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, tfo);
@@ -70,11 +72,13 @@ nlohmann::json tf_rate(std::int64_t n, int reps) {
   });
   glBindVertexArray(0);
   gl::check("pass-through transform feedback");
+  const double ms = w.median_ms();
   return {{"vertices", n},
           {"ms", ms},
           {"vertices_per_s", double(n) / (ms * 1e-3)},
           {"what", "vertex shader copying two vec4 attributes into two transform feedback buffers, rasteriser off"},
-          {"method", gl::Timer().method() + ", median of " + std::to_string(reps)}};
+          {"method", method_words(gl::Timer().method(), w)},
+          {"sm_clock", to_json(w.clock)}};
 }
 
 nlohmann::json compute_copy(std::int64_t n, int reps) {
@@ -82,7 +86,7 @@ nlohmann::json compute_copy(std::int64_t n, int reps) {
   gl::Buffer a = gl::make_buffer(bytes), b = gl::make_buffer(bytes);
   gl::Program prog = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   const GLuint groups = GLuint(std::min<std::int64_t>(65535, (n + 255) / 256));
-  const double ms = gl_median_ms(reps, [&] {
+  const TimedWork w = gl_timed(reps, [&] {
     glUseProgram(prog.id());
     glUniform1i(gl::uniform(prog.id(), "u_n"), GLint(n));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, a.id());
@@ -92,12 +96,14 @@ nlohmann::json compute_copy(std::int64_t n, int reps) {
     glUseProgram(0);
   });
   gl::check("compute-shader copy");
+  const double ms = w.median_ms();
   return {{"nodes", n},
           {"bytes_read_and_written", 2 * bytes},
           {"ms", ms},
           {"GB_per_s", 2.0 * double(bytes) / (ms * 1e6)},
           {"what", "compute shader copying one vec4 per node between two storage buffers"},
-          {"method", gl::Timer().method() + ", median of " + std::to_string(reps)}};
+          {"method", method_words(gl::Timer().method(), w)},
+          {"sm_clock", to_json(w.clock)}};
 }
 
 // Round trips GL -> CUDA -> GL over three buffers of `nodes` vec4 (two CUDA reads, one it
@@ -203,13 +209,15 @@ nlohmann::json calibrate(const CalibrateOptions& o, std::ostream& log) {
                  {"egl_platform", ctx.platform}};
   log << "calibrate: " << d.name << " (CUDA device " << dev << "), GL " << ctx.renderer << "\n";
 
-  const double copy = cuda::copy_ms(o.copy_bytes, o.reps, kGpuWarmUpMs);
+  const TimedWork copy_work = cuda::time_copy(o.copy_bytes, o.reps, kGpuWarmUpMs);
+  const double copy = copy_work.median_ms();
   j["copy"] = {{"bytes", o.copy_bytes},
                {"ms", copy},
                {"GB_per_s", 2.0 * double(o.copy_bytes) / (copy * 1e6)},
                {"what", "cudaMemcpy device to device; GB/s counts read + write"},
-               {"method", "CUDA events, median of " + std::to_string(o.reps) + " after " +
-                               std::to_string(int(kGpuWarmUpMs)) + " ms of copies"}};
+               {"method", method_words("CUDA events", copy_work) + " after " + std::to_string(int(kGpuWarmUpMs)) +
+                              " ms of copies"},
+               {"sm_clock", to_json(copy_work.clock)}};
   log << "  copy: " << j["copy"]["GB_per_s"].get<double>() << " GB/s\n";
   j["transform_feedback"] = tf_rate(o.tf_vertices, o.reps);
   log << "  transform feedback: " << j["transform_feedback"]["vertices_per_s"].get<double>() / 1e6 << " M vertices/s\n";

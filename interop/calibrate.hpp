@@ -16,7 +16,7 @@ struct CalibrateOptions {
   std::int64_t tf_vertices = 2048 * 2048;            // pass-through transform feedback
   std::int64_t compute_nodes = std::int64_t(1) << 23;  // compute-shader copy, one vec4 per node
   std::vector<std::int64_t> hand_off_nodes{64 * 64, 512 * 512, 2048 * 2048};  // 16 B per node per buffer
-  int reps = 10;          // timed repetitions of the bandwidth and rate measurements (median)
+  int reps = 10;          // timed calls of the bandwidth and rate measurements at the least (median)
   int round_trips = 200;  // per hand-off measurement (after 20 warm-up rounds)
 };
 

@@ -69,7 +69,7 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
       >"$out/sanitizer-$tool-cuda.log" 2>&1 &
     if [ -x "$bench" ]; then
       compute-sanitizer --tool "$tool" "$bench" cuda --sizes 64 --variants fused --tiles 16x8 --tile-size 64 \
-        --graph-sizes 64 --temporal-sizes 64 --steps-per-launch 1 --batches 3 --warmup-ms 0 \
+        --graph-sizes 64 --temporal-sizes 64 --steps-per-launch 1 --warmup-ms 0 \
         >"$out/sanitizer-$tool-bench.log" 2>&1 &
     fi
     compute-sanitizer --tool "$tool" "$match_tests" \
@@ -137,11 +137,11 @@ fi
 median_of() { grep -o "\"$1\": [0-9.e+-]*" "$2" | head -1 | awk '{ print $2 }'; }
 if part timing; then
   # One scene (Table 2's, 2048^2, explicit Euler) timed three ways in exact and fast math: a run of
-  # 2000 steps (glsl-tf, 20 ms a step: 200), its experiment cell and the bench's row; each with
-  # the median SM clock the GPU ran it at.
+  # 2000 steps (glsl-tf and hybrid, about 20 ms a step: 200), its experiment cell and the bench's
+  # row; each with the median SM clock the GPU ran it at.
   cat >"$out/clock-check.json" <<'JSON'
 {"name": "clock-check", "base": "table2", "integrator": "explicit-euler",
- "sweep": {"sizes": [2048], "pipelines": ["cuda-fused", "cuda-naive", "glsl-compute", "glsl-tf"],
+ "sweep": {"sizes": [2048], "pipelines": ["cuda-fused", "cuda-naive", "glsl-compute", "glsl-tf", "hybrid", "hybrid-compute"],
            "options": [{"math": "exact"}, {"math": "fast"}],
            "warmup": 10, "steps": 20, "repetitions": 7, "cell_limit_s": 60}}
 JSON
@@ -152,23 +152,27 @@ JSON
     --tiles 16x8 --temporal-sizes 2048 --steps-per-launch 2 --csv "$out/timing-bench-cuda.csv" \
     >"$out/timing-bench-cuda.txt" 2>&1
   "$bench" gl --sizes 2048 --integrator explicit-euler --csv "$out/timing-bench-gl.csv" >"$out/timing-bench-gl.txt" 2>&1
-  # The bench's row of each: cuda [steps] (exact) and [fused] (paper scene, fast); gl by name.
+  "$bench" hybrid --sizes 2048 --integrator explicit-euler --modes map --no-baselines \
+    --csv "$out/timing-bench-hybrid.csv" >"$out/timing-bench-hybrid.txt" 2>&1
+  # The bench's row of each: cuda [steps] (exact) and [fused] (paper scene, fast); gl by name;
+  # hybrid's in map mode (exact: the bench's hybrids take the pipelines' defaults).
   bench_ms() {
     case $1/$2 in
       cuda-fused/exact | cuda-naive/exact) awk -F, -v v="${1#cuda-}" '$1 == "steps" && $5 == v { print $11 " @" $15 }' "$out/timing-bench-cuda.csv" ;;
       cuda-fused/fast) awk -F, '$1 == "fused" && $2 == "paper" && $6 == "explicit-euler" && $8 == "fast" { print $11 " @" $15 }' "$out/timing-bench-cuda.csv" ;;
       glsl-compute/exact | glsl-tf/exact) awk -F, -v w="$1" '$4 == w { print $5 " @" $8 }' "$out/timing-bench-gl.csv" ;;
       glsl-compute/fast) awk -F, '$4 == "glsl-compute-fast" { print $5 " @" $8 }' "$out/timing-bench-gl.csv" ;;
+      hybrid/exact | hybrid-compute/exact) awk -F, -v p="$1" '$2 == p && $3 == "map" { print $6 " @" $12 }' "$out/timing-bench-hybrid.csv" ;;
       *) echo - ;;
     esac
   }
   for pm in cuda-fused/exact cuda-fused/fast cuda-naive/exact cuda-naive/fast glsl-compute/exact glsl-compute/fast \
-    glsl-tf/exact glsl-tf/fast; do
-    p=${pm%/*} math=${pm#*/} steps=2000; [ "$p" = glsl-tf ] && steps=200
+    glsl-tf/exact glsl-tf/fast hybrid/exact hybrid-compute/exact hybrid-compute/fast; do
+    p=${pm%/*} math=${pm#*/} steps=2000; [ "$p" = glsl-tf ] || [ "$p" = hybrid ] && steps=200
     "$app" run --experiment table2 --pipeline "$p" --option "math=$math" --grid 2048x2048 --steps "$steps" \
       --check-every 100000 --no-state --out "/tmp/timing-$p-$math" >"$out/timing-run-$p-$math.log" 2>&1
     cp "/tmp/timing-$p-$math/manifest.json" "$out/timing-run-$p-$math.json"
-    cell=$(ls "$out"/results/clock-check/cells/*"$p"*"$math"* 2>/dev/null | head -1)
+    cell=$(ls "$out"/results/clock-check/cells/"$p"__*"$math"* 2>/dev/null | head -1)
     summary+=("timing $p $math 2048^2 paper scene, ms/step @ median SM MHz: run $(median_of median_step_ms "$out/timing-run-$p-$math.json") @$(median_of sm_mhz_median "$out/timing-run-$p-$math.json"), cell $(median_of median_ms "$cell") @$(median_of sm_mhz_median "$cell"), bench $(bench_ms "$p" "$math")")
   done
   # Three runs each of 2000 steps (glsl-tf, 20 ms a step: 200); "/fast": math=fast; cuda-temporal

@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/timed_work.hpp"
 #include "experiments/pipelines.hpp"
 
 namespace deformlab {
@@ -57,6 +58,28 @@ TEST(Pipelines, TimedStepsSpanTheirTime) {
   EXPECT_EQ(steps_spanning(200, 50, 20, 8), 24);
   EXPECT_EQ(steps_spanning(200, 300, 0), 1);
   EXPECT_EQ(steps_spanning(200, 0, 1), 1000000);
+}
+
+// Work timed as the steps are: the warm-up's mean sets how many calls span kGpuTimedMs, rounded
+// up to the multiple; `prepare` stays outside each call's time; the clock is watched where NVML is.
+TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
+  using namespace std::chrono_literals;
+  HostStepTimer t;
+  int calls = 0, prepared = 0;
+  const TimedWork w = time_back_to_back(
+      t, [&] { ++calls, std::this_thread::sleep_for(4ms); }, 3, 5, {}, 8,
+      [&] { ++prepared, std::this_thread::sleep_for(2ms); });
+  // At 4-5 ms a call (the sleep's overshoot), 200 ms take 40 to 50 calls: whole eights.
+  EXPECT_EQ(w.ms.size() % 8, 0u);
+  EXPECT_GE(w.ms.size(), 40u);
+  EXPECT_LE(w.ms.size(), 56u);
+  EXPECT_EQ(calls, int(w.ms.size()) + 3);
+  EXPECT_EQ(prepared, calls);
+  EXPECT_GE(w.median_ms(), 4.0);
+  EXPECT_LT(w.median_ms(), 6.0);  // without the 2 ms of prepare
+  EXPECT_EQ(w.clock.watched(), ClockWatch::available());
+  // No warm-up: the calls asked for.
+  EXPECT_EQ(time_back_to_back(t, [] {}, 0, 7).ms.size(), 7u);
 }
 
 // Option names and values are read before anything runs: a name the pipeline does not read,

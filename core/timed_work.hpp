@@ -1,0 +1,29 @@
+// Work timed as a GPU pipeline's steps are: after a warm-up, calls back to back (no wait between
+// them) for about kGpuTimedMs, each on a StepTimer, with the GPU's clock watched over them. The
+// benches' cases and references (the copies, the bare gathers) and the calibration time their
+// work this way, so that a reference and the step it is set against share a method.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/clock_watch.hpp"
+#include "core/step_timer.hpp"
+
+namespace deformlab {
+
+struct TimedWork {
+  std::vector<double> ms;  // each timed call, in order
+  ClockSummary clock;      // over the timed calls
+  double median_ms() const;
+};
+
+// `work` on `t` (nothing pending): `warmup` calls, then calls back to back spanning about
+// kGpuTimedMs at the warm-up's mean, `min_calls` at the least (without a warm-up, `min_calls`),
+// rounded up to a multiple of `multiple`; `prepare`, where given, before each call and outside
+// its timer. The GPU with PCI bus id `bus` (empty: NVML's first) is watched over the timed calls.
+TimedWork time_back_to_back(StepTimer& t, const std::function<void()>& work, int warmup, int min_calls,
+                            const std::string& bus = {}, int multiple = 1,
+                            const std::function<void()>& prepare = {});
+
+}  // namespace deformlab
