@@ -93,7 +93,7 @@ class Report {
 
   ClockTally& clocks() { return clocks_; }
 
-  // The bare gather (cuda::bare_gather_ms) of the scene's springs (their neighbours' velocities
+  // The bare gather (cuda::time_bare_gather) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
   // node) or Verlet (80), on cuda-fused's block in fast math.
   Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
