@@ -41,16 +41,6 @@ std::string fused_block(Math m) {
   return cuda::to_string(cuda::default_tile(cuda::Variant::fused, m, Topology::cloth_grid));
 }
 
-// Median ms per step from the rest state: the warm-up (warm_up_from_rest, then o.warmup steps),
-// then steps back to back for about kGpuTimedMs (time_back_to_back; a multiple of 8, so that
-// cuda-temporal's launches are whole), each on the pipeline's step clock (CUDA events), as
-// `deformlab run` times its steps; the GPU `bus` watched over them.
-Stats ms_per_step(cuda::CudaPipeline& p, const Model& m, const CudaOptions& o, const std::string& bus) {
-  warm_up_from_rest(p, m, o.warmup_ms);
-  const auto timer = p.step_timer();
-  return stats(time_back_to_back(*timer, [&] { p.step(); }, o.warmup, 8, bus, 8));
-}
-
 struct Row {
   std::string table, scene, grid, variant, integrator, tile, math;
   bool graphs;
@@ -70,7 +60,8 @@ class Report {
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
     auto p = cuda::make_pipeline(scene.setup(integ), opt);
-    const Stats st = ms_per_step(*p, m, o, bus_);
+    // Timed as `deformlab run` times its steps; a multiple of 8, so that cuda-temporal's launches are whole.
+    const Stats st = stats(time_steps(*p, m, o.warmup_ms, o.warmup, 8, bus_, 8));
     Row r;
     r.table = table;
     r.scene = to_string(kind);
@@ -222,8 +213,8 @@ void run_cuda(const CudaOptions& o) {
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each timed as the steps are (after "
-              << (o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of launches and " : "")
-              << "10 warm-up launches); a reference, not a bound "
+              << (o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of launches and " : "") << cuda::kReferenceWarmUp
+              << " warm-up launches); a reference, not a bound "
               << "(cuda-fused's L2 prefetch can beat it)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
@@ -286,7 +277,7 @@ void run_cuda(const CudaOptions& o) {
         }
     }
   }
-  print_clocks(std::cout, rep.clocks(), "timed steps or launches");
+  print_clocks(std::cout, rep.clocks(), "timed steps, copies or launches");
 }
 
 }  // namespace

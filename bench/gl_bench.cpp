@@ -27,9 +27,7 @@ Stats time_work(const std::function<void()>& prepare, const std::function<void()
 // GPU ms per step of a GL pipeline, each step on its step clock after the warm-up; the GPU's
 // clock over the timed steps.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
-  warm_up_from_rest(p, m, o.warmup_ms);
-  const auto timer = p.step_timer();
-  const Stats s = stats(time_back_to_back(*timer, [&] { p.step(); }, o.warmup, o.reps));
+  const Stats s = stats(time_steps(p, m, o.warmup_ms, o.warmup, o.reps));
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
   return s;
 }

@@ -59,13 +59,6 @@ std::pair<double, double> timed(Pipeline& p, int steps, Profiler* prof) {
   return {ms_since(t0) / steps, host / steps};
 }
 
-// The pipeline's step clock over steps back to back for about kGpuTimedMs after `warmup` more
-// (time_back_to_back, `min_steps` at the least), the GPU `bus` watched.
-TimedWork step_clock(Pipeline& p, int warmup, int min_steps, const std::string& bus) {
-  const auto timer = p.step_timer();
-  return time_back_to_back(*timer, [&] { p.step(); }, warmup, min_steps, bus);
-}
-
 double stage_ms(const Profiler& prof, const char* name) {
   for (const auto& g : prof.summary())
     if (g.name == name) return g.median_ms;
@@ -78,7 +71,7 @@ void run_hybrid(const HybridOptions& o) {
   const int dev = interop::cuda_device_of_gl();
   const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();
   // The floor's ping-pong does no work: copies for o.warmup_ms raise the device's clock first, as
-  // the cases' warm-ups do.
+  // the cases' warm-ups do (their times are not used).
   const bool measure_floor = std::isnan(o.floor_us) && gpusync;
   if (measure_floor) cuda::time_copy(std::int64_t(256) << 20, 1, o.warmup_ms);
   const double floor_us = measure_floor ? interop::hand_off_floor_us(2000) : o.floor_us;
@@ -89,17 +82,17 @@ void run_hybrid(const HybridOptions& o) {
             << o.warmup << " warm-up steps.\n"
             << "gpu: the pipeline's step clock, median per step of steps back to back for about "
             << fixed(kGpuTimedMs, 0) << " ms (at least\n"
-            << o.steps << "; CUDA events for cuda-fused, GL timer queries for glsl-tf and the hybrids, whose GL update\n"
-            << "waits for the CUDA forces), as `deformlab run` times its steps. Then as many steps again:\n"
+            << o.steps << "; CUDA events for cuda-fused, GL timer queries for glsl-tf and the hybrids, whose GL\n"
+            << "update waits for the CUDA forces), as `deformlab run` times its steps. Then as many steps again:\n"
             << "wall: host clock over them, drained at the end, per step. host: host clock inside step().\n"
             << "force: CUDA events;\n"
             << "update: GL timer queries (median per step). hand-off: (wall - force - update) / hand-offs per step\n"
             << "(" << 2 * passes << "); ho-host: host clock inside the hand-off calls per step. floor: GL<->CUDA\n"
             << "semaphore ping-pong with no work, " << fixed(floor_us, 1) << " us per hand-off. bound: wall <= 1.05 x\n"
             << "(update + force + " << 2 * passes << " floors).\n\n";
-  std::ofstream csv = open_csv(
-      o.csv, "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,hand_off_host_us_per_step,floor_us,"
-         "sm_mhz_median,slowed_fraction");
+  std::ofstream csv = open_csv(o.csv,
+                               "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,"
+                               "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction");
   std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
             << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
             << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)
@@ -123,8 +116,7 @@ void run_hybrid(const HybridOptions& o) {
   // Times `p` into `r`: the step clock, then as many steps on the host clock, with `prof` where
   // given (the stage split).
   auto measure = [&](Pipeline& p, const Model& m, Row& r, Profiler* prof) {
-    warm_up_from_rest(p, m, o.warmup_ms);
-    const TimedWork g = step_clock(p, o.warmup, o.steps, bus);
+    const TimedWork g = time_steps(p, m, o.warmup_ms, o.warmup, o.steps, bus);
     r.gpu_ms = g.median_ms();
     r.clock = g.clock;
     clocks.add(std::to_string(r.n) + "^2 " + r.pipeline + (r.mode == "-" ? "" : " " + r.mode), g.clock);
@@ -141,7 +133,7 @@ void run_hybrid(const HybridOptions& o) {
       measure(*cuda::make_pipeline(setup, {cuda::Variant::fused, {}, true}), m, fused, nullptr);
       print(fused);
       Row tf{n, "glsl-tf", "-"};
-      Profiler prof;
+      Profiler prof;  // profiled as the hybrids are, so that the wall times compare
       measure(*gl::make_tf_pipeline(setup), m, tf, &prof);
       print(tf);
     }

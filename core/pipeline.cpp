@@ -6,15 +6,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "timed_work.hpp"
+
 namespace deformlab {
 
 std::vector<double> timed_steps(Pipeline& p, StepTimer& t, int steps) {
-  for (int k = 0; k < steps; ++k) {
-    t.begin();
-    p.step();
-    t.end();
-  }
-  return t.take();
+  return timed_calls(t, [&] { p.step(); }, steps);
 }
 
 WarmUp warm_up(const std::function<void()>& step, const std::function<void()>& drain, double min_ms) {

@@ -12,6 +12,14 @@
 
 namespace deformlab {
 
+class Pipeline;
+struct Model;
+
+// `calls` calls of `work`, each timed by `t` (`prepare`, where given, before each and outside its
+// time); their ms in order (waits for them).
+std::vector<double> timed_calls(StepTimer& t, const std::function<void()>& work, int calls,
+                                const std::function<void()>& prepare = {});
+
 struct TimedWork {
   std::vector<double> ms;  // each timed call, in order
   ClockSummary clock;      // over the timed calls
@@ -20,10 +28,15 @@ struct TimedWork {
 
 // `work` on `t` (nothing pending): `warmup` calls, then calls back to back spanning about
 // kGpuTimedMs at the warm-up's mean, `min_calls` at the least (without a warm-up, `min_calls`),
-// rounded up to a multiple of `multiple`; `prepare`, where given, before each call and outside
-// its timer. The GPU with PCI bus id `bus` (empty: NVML's first) is watched over the timed calls.
+// rounded up to a multiple of `multiple`; `prepare` as timed_calls'. The GPU with PCI bus id
+// `bus` (empty: NVML's first) is watched over the timed calls.
 TimedWork time_back_to_back(StepTimer& t, const std::function<void()>& work, int warmup, int min_calls,
                             const std::string& bus = {}, int multiple = 1,
                             const std::function<void()>& prepare = {});
+
+// A GPU pipeline's steps timed as `deformlab run` times them: warm_up_from_rest(p, m, warm_ms),
+// then time_back_to_back of p's steps on its step clock.
+TimedWork time_steps(Pipeline& p, const Model& m, double warm_ms, int warmup, int min_steps,
+                     const std::string& bus = {}, int multiple = 1);
 
 }  // namespace deformlab

@@ -117,16 +117,17 @@ struct DeviceInfo {
   std::string pci_bus_id;  // e.g. "0000:1B:00.0": which GPU a ClockWatch reads
 };
 DeviceInfo device_info(int device = -1);  // -1: the current device
-// A device-to-device cudaMemcpy of `bytes`, timed as the steps are (time_back_to_back: copies
-// back to back for about kGpuTimedMs, `min_reps` at the least, each ended by a CUDA event, after
-// copies for `warm_ms` (warm_up) and 3 more), with the device's clock over them.
+// The benchmarks' references, timed as the steps are (time_back_to_back: calls back to back for
+// about kGpuTimedMs, each ended by a CUDA event) after calls for `warm_ms` (warm_up) and
+// kReferenceWarmUp more, with the device's clock over them.
+inline constexpr int kReferenceWarmUp = 10;
+// A device-to-device cudaMemcpy of `bytes`, `min_reps` at the least.
 TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms);
 // The bare gather: cuda-fused's loads and stores on an n x n cloth without its arithmetic
 // (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs); the
 // previous positions with `previous` (Verlet)), on blocks of `tile`: the fastest of three load
-// schedules (1, 2 or 4 neighbours' loads at a time) by median, each timed as time_copy's copies
-// (after launches for `warm_ms` and 10 more). A reference for the gather's memory traffic, not a
-// bound: cuda-fused's L2 prefetch, which it lacks, can beat it.
+// schedules (1, 2 or 4 neighbours' loads at a time) by median. A reference for the gather's
+// memory traffic, not a bound: cuda-fused's L2 prefetch, which it lacks, can beat it.
 TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, double warm_ms);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.

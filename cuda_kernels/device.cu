@@ -40,10 +40,25 @@ void require_device_memory(std::int64_t bytes, const std::string& what) {
                                 std::to_string(free) + " of " + std::to_string(total) + " bytes are free");
 }
 
+namespace {
+
+// The CUDA device `device` (-1: the current one).
+int device_or_current(int device) {
+  if (device < 0) check(cudaGetDevice(&device), "querying the current device");
+  return device;
+}
+
+std::string pci_bus_id(int device) {
+  char bus[32] = {};
+  check(cudaDeviceGetPCIBusId(bus, sizeof bus, device_or_current(device)), "querying the PCI bus id");
+  return bus;
+}
+
+}  // namespace
+
 DeviceInfo device_info(int device) {
   DeviceInfo d;
-  int dev = device;
-  if (dev < 0) check(cudaGetDevice(&dev), "querying the current device");
+  const int dev = device_or_current(device);
   cudaDeviceProp p{};
   check(cudaGetDeviceProperties(&p, dev), "querying device properties");
   d.name = p.name;
@@ -53,24 +68,22 @@ DeviceInfo device_info(int device) {
   d.cc_minor = p.minor;
   check(cudaDriverGetVersion(&d.driver_version), "querying the driver version");
   check(cudaRuntimeGetVersion(&d.runtime_version), "querying the runtime version");
-  char bus[32] = {};
-  check(cudaDeviceGetPCIBusId(bus, sizeof bus, dev), "querying the PCI bus id");
-  d.pci_bus_id = bus;
+  d.pci_bus_id = pci_bus_id(dev);
   return d;
 }
 
 namespace {
 
 // `work` on the default stream timed as the steps are (time_back_to_back: one event at each
-// call's end, as EventStepTimer times steps), after calls for `warm_ms` (warm_up) and `warmup`
-// more; the current device's clock watched. `what` names the work.
+// call's end, as EventStepTimer times steps), after calls for `warm_ms` (warm_up) and
+// kReferenceWarmUp more; the current device's clock watched. `what` names the work.
 template <class Work>
-TimedWork time_launches(double warm_ms, int warmup, int min_calls, Work&& work, const std::string& what) {
+TimedWork time_launches(double warm_ms, int min_calls, Work&& work, const std::string& what) {
   warm_up(work, [&] { check(cudaDeviceSynchronize(), ("warming up " + what).c_str()); }, warm_ms);
   check_launch(("starting " + what).c_str());
   std::int64_t launched = 0;
   EventStepTimer timer(nullptr, &launched, [] {});
-  return time_back_to_back(timer, [&] { work(), ++launched; }, warmup, min_calls, device_info().pci_bus_id);
+  return time_back_to_back(timer, [&] { work(), ++launched; }, kReferenceWarmUp, min_calls, pci_bus_id(-1));
 }
 
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
@@ -116,7 +129,7 @@ TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms) {
   a.allocate(std::size_t(bytes), "allocating the copy source");
   b.allocate(std::size_t(bytes), "allocating the copy destination");
   check(cudaMemset(a.get(), 1, std::size_t(bytes)), "filling the copy source");
-  return time_launches(warm_ms, 3, min_reps, [&] {
+  return time_launches(warm_ms, min_reps, [&] {
     check(cudaMemcpyAsync(b.get(), a.get(), std::size_t(bytes), cudaMemcpyDeviceToDevice), "copying device memory");
   }, "the copy");
 }
@@ -143,7 +156,7 @@ TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, dou
   TimedWork best;
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
                               pick(std::integral_constant<int, 4>{})}) {
-    TimedWork w = time_launches(warm_ms, 10, 10, [&] {
+    TimedWork w = time_launches(warm_ms, 10, [&] {
       kernel<<<blocks, threads>>>(n, x.get(), v.get(), xp.get(), xo.get(), vo.get());
     }, "the bare gather");
     if (best.ms.empty() || w.median_ms() < best.median_ms()) best = std::move(w);

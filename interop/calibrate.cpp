@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <numeric>
 
 #include "core/timed_work.hpp"
 #include "cuda_kernels/check.cuh"
@@ -24,20 +26,20 @@ double since_ms(clock_type::time_point t0) {
 }
 
 // GL work timed as the steps are (time_back_to_back on GL timer queries, or the host clock on a
-// software driver): `reps` calls at the least, after 3.
-template <class F>
-TimedWork gl_timed(int reps, F&& work) {
+// software driver): `reps` calls at the least, after 3; the GPU `bus` watched.
+TimedWork gl_timed(int reps, const std::string& bus, const std::function<void()>& work) {
   gl::QueryStepTimer timer;
-  return time_back_to_back(timer, work, 3, reps);
+  return time_back_to_back(timer, work, 3, reps, bus);
 }
 
 // How `w` was timed on `clock`, for the JSON.
 std::string method_words(const std::string& clock, const TimedWork& w) {
-  return clock + ", median of " + std::to_string(w.ms.size()) + " back to back (about " +
-         std::to_string(int(kGpuTimedMs)) + " ms)";
+  const double span = std::accumulate(w.ms.begin(), w.ms.end(), 0.0);
+  return clock + ", median of " + std::to_string(w.ms.size()) + " back to back (" + std::to_string(int(span)) +
+         " ms of them)";
 }
 
-nlohmann::json tf_rate(std::int64_t n, int reps) {
+nlohmann::json tf_rate(std::int64_t n, int reps, const std::string& bus) {
   const std::size_t bytes = std::size_t(n) * 16;
   gl::Buffer in_x = gl::make_buffer(bytes), in_v = gl::make_buffer(bytes);
   gl::Buffer out_x = gl::make_buffer(bytes), out_v = gl::make_buffer(bytes);
@@ -59,7 +61,7 @@ nlohmann::json tf_rate(std::int64_t n, int reps) {
   glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, out_x.id());
   glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 1, out_v.id());
   glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
-  const TimedWork w = gl_timed(reps, [&] {
+  const TimedWork w = gl_timed(reps, bus, [&] {
     glUseProgram(prog.id());
     glEnable(GL_RASTERIZER_DISCARD);
     glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, tfo);
@@ -81,12 +83,12 @@ nlohmann::json tf_rate(std::int64_t n, int reps) {
           {"sm_clock", to_json(w.clock)}};
 }
 
-nlohmann::json compute_copy(std::int64_t n, int reps) {
+nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus) {
   const std::size_t bytes = std::size_t(n) * 16;
   gl::Buffer a = gl::make_buffer(bytes), b = gl::make_buffer(bytes);
   gl::Program prog = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   const GLuint groups = GLuint(std::min<std::int64_t>(65535, (n + 255) / 256));
-  const TimedWork w = gl_timed(reps, [&] {
+  const TimedWork w = gl_timed(reps, bus, [&] {
     glUseProgram(prog.id());
     glUniform1i(gl::uniform(prog.id(), "u_n"), GLint(n));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, a.id());
@@ -219,9 +221,9 @@ nlohmann::json calibrate(const CalibrateOptions& o, std::ostream& log) {
                               " ms of copies"},
                {"sm_clock", to_json(copy_work.clock)}};
   log << "  copy: " << j["copy"]["GB_per_s"].get<double>() << " GB/s\n";
-  j["transform_feedback"] = tf_rate(o.tf_vertices, o.reps);
+  j["transform_feedback"] = tf_rate(o.tf_vertices, o.reps, d.pci_bus_id);
   log << "  transform feedback: " << j["transform_feedback"]["vertices_per_s"].get<double>() / 1e6 << " M vertices/s\n";
-  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps);
+  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id);
   log << "  compute copy: " << j["compute_copy"]["GB_per_s"].get<double>() << " GB/s\n";
 
   // external-gpusync last: it brings up Vulkan, the one mode that touches a third API.

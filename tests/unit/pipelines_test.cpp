@@ -4,7 +4,9 @@
 
 #include <chrono>
 #include <numeric>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/timed_work.hpp"
@@ -60,26 +62,30 @@ TEST(Pipelines, TimedStepsSpanTheirTime) {
   EXPECT_EQ(steps_spanning(200, 0, 1), 1000000);
 }
 
-// Work timed as the steps are: the warm-up's mean sets how many calls span kGpuTimedMs, rounded
-// up to the multiple; `prepare` stays outside each call's time; the clock is watched where NVML is.
+// Work timed as the steps are: the warm-up's mean (4 ms a call) sets how many calls span
+// kGpuTimedMs (50, rounded up to 56, a multiple of 8); `prepare` runs before each call, outside
+// its timer; the clock is watched where NVML is.
 TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
-  using namespace std::chrono_literals;
-  HostStepTimer t;
-  int calls = 0, prepared = 0;
+  // A timer that gives each call 4 ms and logs the order of events.
+  struct FixedTimer final : StepTimer {
+    std::string log;
+    int ended = 0;
+    void begin() override { log += 'b'; }
+    void end() override { log += 'e', ++ended; }
+    std::vector<double> take() override { return std::vector<double>(std::exchange(ended, 0), 4.0); }
+    std::string clock() const override { return "fixed"; }
+  } t;
   const TimedWork w = time_back_to_back(
-      t, [&] { ++calls, std::this_thread::sleep_for(4ms); }, 3, 5, {}, 8,
-      [&] { ++prepared, std::this_thread::sleep_for(2ms); });
-  // At 4-5 ms a call (the sleep's overshoot), 200 ms take 40 to 50 calls: whole eights.
-  EXPECT_EQ(w.ms.size() % 8, 0u);
-  EXPECT_GE(w.ms.size(), 40u);
-  EXPECT_LE(w.ms.size(), 56u);
-  EXPECT_EQ(calls, int(w.ms.size()) + 3);
-  EXPECT_EQ(prepared, calls);
-  EXPECT_GE(w.median_ms(), 4.0);
-  EXPECT_LT(w.median_ms(), 6.0);  // without the 2 ms of prepare
+      t, [&] { t.log += 'w'; }, 3, 5, {}, 8, [&] { t.log += 'p'; });
+  EXPECT_EQ(w.ms.size(), 56u);
+  EXPECT_EQ(w.median_ms(), 4.0);
+  std::string expected;
+  for (int c = 0; c < 3 + 56; ++c) expected += "pbwe";
+  EXPECT_EQ(t.log, expected);
   EXPECT_EQ(w.clock.watched(), ClockWatch::available());
-  // No warm-up: the calls asked for.
+  // No warm-up: the calls asked for; slow calls: at least `min_calls`.
   EXPECT_EQ(time_back_to_back(t, [] {}, 0, 7).ms.size(), 7u);
+  EXPECT_EQ(time_back_to_back(t, [] {}, 2, 70).ms.size(), 70u);
 }
 
 // Option names and values are read before anything runs: a name the pipeline does not read,
