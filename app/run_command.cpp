@@ -134,6 +134,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"integrator", std::string(info(in.integ).name)},
       {"until_converged", in.until_converged},
       {"options", in.options},
+      {"chosen_options", pipe.chosen_options()},
       {"scene", to_json(in.x.scene)},
       {"model", {{"nodes", in.model.node_count()}, {"springs", in.model.spring_count()},
                  {"drag_node", in.params.drag.active() ? in.model.file_index(in.params.drag.node) : -1},
@@ -166,14 +167,16 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
   return manifest;
 }
 
-void print_summary(const RunArgs& a, const RunInput& in, const Ran& ran, const Profiler& profiler, const StepMedians& med, const json& compare, const OutputDir& dir,
-                   double setup_s) {
+void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, const Ran& ran, const Profiler& profiler,
+                   const StepMedians& med, const json& compare, const OutputDir& dir, double setup_s) {
   const Model& m = in.model;
   const RunResult& r = ran.result;
   const WarmUp& warm = ran.warm_up;
   std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name) << " on " << in.entry->name << " ("
             << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
             << m.spring_count() << " springs\n";
+  for (const auto& [name, value] : pipe.chosen_options())
+    std::cout << "  option " << name << "=" << value << ": chosen for this machine (none given)\n";
   for (const auto& line : m.repairs) std::cout << "  mesh: " << line << "\n";
   std::cout << "  steps: " << r.steps << " (" << r.steps * double(in.params.dt) << " s simulated); ";
   if (in.until_converged)
@@ -262,7 +265,7 @@ int run_command(const RunArgs& a) {
 #endif
     write_json(dir.staged("manifest.json"), manifest);
     dir.commit();
-    print_summary(a, in, ran, profiler, med, compare, dir, setup_s);
+    print_summary(a, in, *pipe, ran, profiler, med, compare, dir, setup_s);
     return 0;
   });
 }

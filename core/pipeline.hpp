@@ -56,6 +56,9 @@ class Pipeline {
   // Pipelines that time their stages add spans (force, hand-off, update, ...) to `p` from
   // now on; null stops it. The default records nothing.
   virtual void set_profiler(Profiler* p) { (void)p; }
+  // The options this pipeline chose for itself, by the machine it runs on, where none was given
+  // (the hybrids' interop mode), as PipelineOptions would name them; runs and cells record them.
+  virtual std::map<std::string, std::string> chosen_options() const { return {}; }
 };
 
 // Per-pipeline settings by name, e.g. {"tile": "16x8"} or {"interop": "map"}; each

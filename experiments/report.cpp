@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "core/clock_watch.hpp"
 #include "paper.hpp"
@@ -99,6 +101,26 @@ void write_clocks(Report& r) {
          << " ms): " << tally.describe("cell") << "\n";
 }
 
+// The options pipelines chose for the machine where the experiment gave none (the hybrids'
+// interop mode), each with the pipelines that chose it.
+void write_chosen_options(Report& r) {
+  std::map<std::string, std::set<std::string>> chosen;
+  for (const auto& c : r.cells)
+    if (c.contains("chosen_options"))
+      for (const auto& [name, value] : c["chosen_options"].items())
+        chosen[name + "=" + value.get<std::string>()].insert(c["pipeline"].get<std::string>());
+  if (chosen.empty()) return;
+  r.md << "- Options chosen for this machine where none was given:";
+  bool first = true;
+  for (const auto& [option, pipelines] : chosen) {
+    r.md << (std::exchange(first, false) ? " " : "; ") << option << " (";
+    bool first_pipeline = true;
+    for (const auto& p : pipelines) r.md << (std::exchange(first_pipeline, false) ? "" : ", ") << p;
+    r.md << ")";
+  }
+  r.md << "\n";
+}
+
 // How the cells were timed, as the first measured cell says, and each step clock with the
 // pipelines it times.
 void write_method(Report& r) {
@@ -127,6 +149,7 @@ void write_method(Report& r) {
     }
     r.md << "\n";
   }
+  write_chosen_options(r);
   write_clocks(r);
   r.md << "\n";
 }

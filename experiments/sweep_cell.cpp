@@ -204,6 +204,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, bool gpu) {
   r["samples_ms"] = ms;
   r["stable"] = d == d;
   r["pipeline_timing"] = pipe.timing_method();
+  if (const auto chosen = pipe.chosen_options(); !chosen.empty()) r["chosen_options"] = chosen;
   r["time"] = s.time;
   r["method"] = method_of(s);
   r["steps_per_batch"] = per_batch;

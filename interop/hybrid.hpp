@@ -4,6 +4,7 @@
 // alternate CUDA force passes and GL update passes: two hand-offs per force pass.
 #pragma once
 #include <memory>
+#include <optional>
 
 #include "core/pipeline.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
@@ -15,12 +16,16 @@ enum class Update { transform_feedback, compute };
 
 struct HybridOptions {
   Update update = Update::transform_feedback;
-  Mode mode = Mode::map;
+  std::optional<Mode> mode;                     // none given: default_mode()
   cuda::Variant force = cuda::Variant::naive;  // naive, tiled or scatter
   cuda::Tile tile;                              // thread block of the grid force kernels (0 x 0: default)
   Math math = Math::exact;                      // the CUDA force pass's and the GL update's arithmetic
 };
 
+// The interop mode the hybrids run when none is given: external-gpusync where this machine has it,
+// else map. Its buffers come from CUDA's allocator: on unordered meshes the force kernels' gathers
+// take 1.8-3.5x as long on GL's buffers (map), and its hand-offs are the cheapest (README, Meshes).
+Mode default_mode();
 // Reads the pipeline options `interop`, `force`, `tile` and `math` (throws std::invalid_argument on a
 // bad value).
 HybridOptions hybrid_options(const PipelineOptions& o, Update u);

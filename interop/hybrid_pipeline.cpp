@@ -31,6 +31,8 @@ HybridOptions hybrid_options(const PipelineOptions& o, Update u) {
   return h;
 }
 
+Mode default_mode() { return unavailable(Mode::external_gpusync).empty() ? Mode::external_gpusync : Mode::map; }
+
 std::string hybrid_unsupported(Integrator i) {
   if (i == Integrator::backward_euler)
     return "backward-euler needs a linear solve per step; the hybrid pipelines have force and update passes only "
@@ -47,7 +49,9 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
  public:
   HybridPipeline(const PipelineSetup& s, const HybridOptions& o) : p_(s.params), sched_(make_schedule(s.integrator)) {
     if (const std::string why = hybrid_unsupported(s.integrator); !why.empty()) throw std::invalid_argument(why);
-    sb_ = make_shared_buffers(o.mode);  // selects the CUDA device behind the GL context
+    const Mode mode = o.mode.value_or(default_mode());
+    if (!o.mode) chosen_["interop"] = to_string(mode);
+    sb_ = make_shared_buffers(mode);  // selects the CUDA device behind the GL context
     fp_ = cuda::make_force_pass(s.model, p_, o.force, o.tile, o.math);
     auto shared = [this](std::size_t bytes, gl::NodeRole role) {
       return sb_->add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
@@ -83,6 +87,7 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
   }
   // GL's clock: its update pass waits for the CUDA forces, so a step's two GL ends span both.
   std::unique_ptr<StepTimer> step_timer() override { return gl_->step_timer(); }
+  std::map<std::string, std::string> chosen_options() const override { return chosen_; }
   // Spans still pending go to the profiler they were taken for.
   void set_profiler(Profiler* p) override {
     collect();
@@ -122,6 +127,7 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
 
   Params p_;
   Schedule sched_;
+  std::map<std::string, std::string> chosen_;
   Profiler* prof_ = nullptr;
   cuda::EventSpans force_spans_;
   gl::TimerSpans update_spans_;

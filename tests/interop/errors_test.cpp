@@ -21,7 +21,7 @@ TEST(InteropOptions, ModesParseByTheirExperimentNames) {
 
 TEST(InteropOptions, HybridOptionsReadInteropAndForce) {
   const HybridOptions d = hybrid_options({}, Update::compute);
-  EXPECT_EQ(d.mode, Mode::map);
+  EXPECT_FALSE(d.mode.has_value());  // default_mode(), chosen where the pipeline is made
   EXPECT_EQ(d.force, cuda::Variant::naive);
   EXPECT_EQ(d.update, Update::compute);
   const HybridOptions o = hybrid_options({{"interop", "external-gpusync"}, {"force", "scatter"}}, Update::transform_feedback);

@@ -3,6 +3,7 @@
 // be bitwise equal) and the spans of each stage. Against the CPU: tests/match.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <tuple>
 
 #include "core/cpu_backend.hpp"
@@ -74,6 +75,24 @@ INSTANTIATE_TEST_SUITE_P(Hybrid, ModesAgree,
                              if (ch == '-') ch = '_';
                            return s;
                          });
+
+// Without an interop option a hybrid runs default_mode() (external-gpusync where this machine
+// has it) and says so; with one it chooses nothing.
+TEST(HybridDefaults, InteropModeChosenAndRecorded) {
+  DEFORMLAB_REQUIRE_INTEROP(Mode::map);
+  const Scenario sc = scenario(Integrator::semi_implicit_euler);
+  const PipelineSetup setup{sc.model, sc.params, Integrator::semi_implicit_euler};
+  const Mode expected = unavailable(Mode::external_gpusync).empty() ? Mode::external_gpusync : Mode::map;
+  EXPECT_EQ(default_mode(), expected);
+  for (Update u : {Update::transform_feedback, Update::compute}) {
+    HybridOptions o;
+    o.update = u;
+    const auto chosen = make_hybrid_pipeline(setup, o)->chosen_options();
+    EXPECT_EQ(chosen, (std::map<std::string, std::string>{{"interop", to_string(expected)}}));
+    o.mode = Mode::staged;
+    EXPECT_TRUE(make_hybrid_pipeline(setup, o)->chosen_options().empty());
+  }
+}
 
 // A profiled run records the force, hand-off and update spans of every step it samples (all
 // of them, or steps 1-8 and 17-20 of 20 with one window of 8 in 2), each with its clock.

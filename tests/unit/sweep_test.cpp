@@ -224,6 +224,7 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
               {"options", json::object()}, {"nodes", n * n}, {"status", "ok"}, {"median_ms", ms}, {"method", "fixed"},
               {"build", "g"},
               {"step_clock", p == "omp" ? "host clock" : "GL timer queries (GL_TIMESTAMP)"}};
+    if (p != "omp") c["chosen_options"] = {{"interop", "external-gpusync"}};  // as a hybrid would record it
     if (p != "omp")  // the GPU's clock, held down by its power cap in half of the samples
       c["sm_clock"] = {{"device", "test gpu"}, {"samples", 10}, {"sm_mhz_min", 1410}, {"sm_mhz_median", 1485},
                        {"sm_mhz_max", 1980}, {"sm_mhz_top", 1980}, {"slowed_fraction", 0.5},
@@ -264,6 +265,9 @@ TEST_F(SweepTest, ReportFromAFixedResultsFolder) {
   const std::string line = md.substr(clocks, md.find('\n', clocks) - clocks);
   EXPECT_NE(line.find("host clock (omp)"), std::string::npos) << line;
   EXPECT_NE(line.find("GL timer queries (GL_TIMESTAMP) (glsl-tf)"), std::string::npos) << line;
+  EXPECT_NE(md.find("- Options chosen for this machine where none was given: interop=external-gpusync (glsl-tf)\n"),
+            std::string::npos)
+      << md;
   EXPECT_NE(md.find("- GPU clock over the timed batches (NVML, sampled every 5 ms): the cells' median SM clocks 1485 "
                     "MHz; 1 of 1 cells timed while a slowdown held the clock down: glsl-tf64 (power cap in 50% of "
                     "samples, 1410-1980 MHz)\n"),
