@@ -11,6 +11,7 @@
 #include "core/cpu_backend.hpp"
 #include "core/run.hpp"
 #include "experiments/output.hpp"
+#include "experiments/pipelines.hpp"
 #include "run_input.hpp"
 #if DEFORMLAB_GL_RENDER
 #include "gl/render.hpp"
@@ -52,7 +53,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   if (warm_ms > 0.0) warm = warm_up_from_rest(pipe, in.model, warm_ms);
   else pipe.set_state(rest_state(in.model));
   std::optional<ClockWatch> watch;
-  if (on_gpu(*in.entry)) watch.emplace();
+  if (on_gpu(*in.entry)) watch.emplace(gpu_bus_id(*in.entry));
   const auto clock = [&] { return watch ? watch->stop() : ClockSummary{}; };
   RunOptions opt;
   opt.until_converged = in.until_converged;

@@ -55,7 +55,7 @@ void run_draw(const StepOptions& o) {
       std::vector<double> frame_ms;
       std::optional<ClockWatch> watch;
       for (int k = 0; k < o.warmup + o.reps; ++k) {
-        if (k == o.warmup) watch.emplace();
+        if (k == o.warmup) watch.emplace(gpu_bus_id(e));
         p->max_displacement();  // drains the pipeline's work
         glFinish();
         const auto t0 = std::chrono::steady_clock::now();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "experiments/pipelines.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 
@@ -17,17 +18,23 @@ namespace deformlab::bench {
 
 namespace {
 
+// The GPU behind the GL context, whose clock the cases watch.
+const std::string& gl_bus() {
+  static const std::string bus = gpu_bus_id(*pipelines().find("glsl-compute"));
+  return bus;
+}
+
 // `work` on GL timer queries (after `prepare`, untimed, each time) as the steps are timed
 // (time_back_to_back: o.warmup calls, then about kGpuTimedMs of them, o.reps at the least).
 Stats time_work(const std::function<void()>& prepare, const std::function<void()>& work, const StepOptions& o) {
   gl::QueryStepTimer timer;
-  return stats(time_back_to_back(timer, work, o.warmup, o.reps, {}, 1, prepare));
+  return stats(time_back_to_back(timer, work, o.warmup, o.reps, gl_bus(), 1, prepare));
 }
 
 // GPU ms per step of a GL pipeline, each step on its step clock after the warm-up; the GPU's
 // clock over the timed steps.
 Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
-  const Stats s = stats(time_steps(p, m, o.warmup_ms, o.warmup, o.reps));
+  const Stats s = stats(time_steps(p, m, o.warmup_ms, o.warmup, o.reps, gl_bus()));
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
   return s;
 }

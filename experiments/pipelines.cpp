@@ -4,6 +4,7 @@
 
 #include "core/cpu_backend.hpp"
 #if DEFORMLAB_HAVE_CUDA
+#include "cuda_kernels/cuda_pipeline.hpp"
 #include "cuda_kernels/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_GL
@@ -11,6 +12,7 @@
 #endif
 #if DEFORMLAB_HAVE_INTEROP
 #include "interop/pipelines.hpp"
+#include "interop/shared_buffers.hpp"
 #endif
 
 namespace deformlab {
@@ -89,6 +91,23 @@ PipelineRegistry build() {
 const PipelineRegistry& pipelines() {
   static const PipelineRegistry r = build();
   return r;
+}
+
+std::string gpu_bus_id(const PipelineEntry& e) {
+  (void)e;
+#if DEFORMLAB_HAVE_INTEROP
+  if (e.traits.update == Engine::gl_compute || e.traits.update == Engine::gl_transform_feedback) {
+    try {
+      return cuda::device_info(interop::cuda_device_of_gl()).pci_bus_id;
+    } catch (const std::invalid_argument&) {  // no CUDA device behind the context (software GL)
+      return {};
+    }
+  }
+#endif
+#if DEFORMLAB_HAVE_CUDA
+  if (e.traits.force == Engine::cuda) return cuda::device_info().pci_bus_id;
+#endif
+  return {};
 }
 
 const PipelineEntry& best_pipeline(Integrator i) {

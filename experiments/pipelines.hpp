@@ -8,6 +8,11 @@
 namespace deformlab {
 
 const PipelineRegistry& pipelines();
+// The PCI bus id of the GPU that runs `e`'s passes (a CUDA pipeline: the current CUDA device; a GL
+// one: the CUDA device behind the GL context), which ClockWatch reads; empty for CPU pipelines and
+// where it cannot be told (GL without a CUDA device behind it: ClockWatch then reads NVML's
+// first GPU).
+std::string gpu_bus_id(const PipelineEntry& e);
 // The first pipeline in order of expected speed that is available here and runs `i`.
 const PipelineEntry& best_pipeline(Integrator i);
 

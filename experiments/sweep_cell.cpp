@@ -179,7 +179,8 @@ std::string method_of(const Sweep& s) {
 // pipeline untimed steps from rest for kGpuWarmUpMs come first, as in `deformlab run`, so that
 // the steps that bound the cell and the timed ones run at the device's working clock, and the
 // GPU's clock is watched over the timed batches.
-json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, bool gpu) {
+json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, const PipelineEntry& e) {
+  const bool gpu = on_gpu(e);
   CellSteps steps(pipe, m, s.time);
   int per_batch = s.steps;
   if (gpu) {
@@ -193,7 +194,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, bool gpu) {
   if (auto why = cut_after_second_step(steps, s, per_batch); !why.empty()) return not_applicable(r, why);
   const std::unique_ptr<StepTimer> timer = s.time == "frame" ? nullptr : pipe.step_timer();
   std::optional<ClockWatch> watch;
-  if (gpu) watch.emplace();
+  if (gpu) watch.emplace(gpu_bus_id(e));
   const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s, per_batch);
   const ClockSummary clock = watch ? watch->stop() : ClockSummary{};
   const double d = pipe.max_displacement();
@@ -236,7 +237,7 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
       if (auto why = record_mesh(m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
     const Params p = resolve_params(scene, m);
     auto pipe = e.make({m, p, integ, c.options});
-    return measure(r, *pipe, m, s, on_gpu(e));
+    return measure(r, *pipe, m, s, e);
   } catch (const std::invalid_argument& ex) {
     return not_applicable(r, ex.what());
   } catch (const std::bad_alloc&) {

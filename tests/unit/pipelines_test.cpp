@@ -88,6 +88,25 @@ TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
   EXPECT_EQ(time_back_to_back(t, [] {}, 2, 70).ms.size(), 70u);
 }
 
+// The clock is watched on the GPU that runs a pipeline: none for the CPU pipelines; where NVML
+// sees a GPU, the one running each GPU pipeline available here, by its PCI bus id.
+TEST(Pipelines, ClockWatchedOnTheGpuThatRunsThem) {
+  EXPECT_EQ(gpu_bus_id(*pipelines().find("cpu")), "");
+  EXPECT_EQ(gpu_bus_id(*pipelines().find("omp")), "");
+  if (!ClockWatch::available()) GTEST_SKIP() << "no NVIDIA driver's NVML here";
+  for (const char* name : {"cuda-fused", "glsl-compute", "glsl-tf", "hybrid"}) {
+    const PipelineEntry& e = *pipelines().find(name);
+    if (!e.unavailable().empty()) continue;
+    const std::string bus = gpu_bus_id(e);
+    EXPECT_FALSE(bus.empty()) << name;
+    ClockWatch w(bus);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const ClockSummary c = w.stop();
+    EXPECT_TRUE(c.watched()) << name << " on " << bus;
+    EXPECT_NE(c.device.find(bus), std::string::npos) << c.device;
+  }
+}
+
 // Option names and values are read before anything runs: a name the pipeline does not read,
 // and every value a backend built here cannot read, are refused with the pipeline's name.
 TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
