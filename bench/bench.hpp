@@ -47,6 +47,9 @@ std::string clock_columns(const ClockSummary& c);
 void print_clocks(std::ostream& os, const ClockTally& clocks, const std::string& timed);
 
 
+// A bench's first words: "deformlab-bench NAME (build GIT):", the build that measures.
+std::string title(const char* name);
+
 // `v` with `prec` decimals; "-" for NaN (not measured).
 std::string fixed(double v, int prec);
 

@@ -12,7 +12,7 @@ namespace {
 void run_cpu(const StepOptions& o) {
   const Integrator integ = o.integ();
   const SceneKind kind = o.scene_kind();
-  std::cout << "deformlab-bench cpu: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
+  std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
             << o.reps << " timed steps; omp uses all hardware threads\n\n"

@@ -143,7 +143,7 @@ void run_cuda(const CudaOptions& o) {
   const TimedWork copy_work = cuda::time_copy(copy_bytes, 20, o.warmup_ms);
   const double copy = copy_work.median_ms();
   const double copy_gbs = 2.0 * double(copy_bytes) / (copy * 1e-3) / 1e9;
-  std::cout << "deformlab-bench cuda: " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
+  std::cout << title("cuda") << " " << dev.name << " (sm_" << dev.cc_major << dev.cc_minor << ", " << dev.sm_count
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
             << "method: a CUDA event at each step's end (the pipeline's step clock) after " << warm_up_words(o)

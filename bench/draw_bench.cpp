@@ -24,7 +24,7 @@ const char* to_string(Route r) {
 void run_draw(const StepOptions& o) {
   const gl::ContextInfo& ctx = gl::context();
   const Integrator integ = o.integ();
-  std::cout << "deformlab-bench draw: GL " << ctx.renderer << "; cloth n x n, " << describe(o.scene_kind())
+  std::cout << title("draw") << " GL " << ctx.renderer << "; cloth n x n, " << describe(o.scene_kind())
             << ", drawn 1280 x 800 as a surface.\n"
             << "frame: host clock from a drained device (the pipeline's last step done) to glFinish after the draw,\n"
             << "the state's hand-over included; draw: the draw alone on " << gl::Timer().method() << ".\n"

@@ -130,7 +130,7 @@ void run_gl(const StepOptions& o) {
   const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
   const SceneKind kind = o.scene_kind();
-  std::cout << "deformlab-bench gl: ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
+  std::cout << title("gl") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
             << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o) << o.warmup

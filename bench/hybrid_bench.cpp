@@ -77,7 +77,7 @@ void run_hybrid(const HybridOptions& o) {
   const double floor_us = measure_floor ? interop::hand_off_floor_us(2000) : o.floor_us;
   const int passes = info(integ).force_passes;
   const SceneKind kind = o.scene_kind();
-  std::cout << "deformlab-bench hybrid: CUDA device " << dev << ", GL " << ctx.renderer << "\n"
+  std::cout << title("hybrid") << " CUDA device " << dev << ", GL " << ctx.renderer << "\n"
             << "cloth n x n, " << describe(kind) << "; " << o.integrator << ", " << warm_up_words(o)
             << o.warmup << " warm-up steps.\n"
             << "gpu: the pipeline's step clock, median per step of steps back to back for about "

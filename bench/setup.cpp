@@ -8,6 +8,7 @@
 #include "bench.hpp"
 #include "core/profiler.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/output.hpp"
 #include "mesh/scene_model.hpp"
 
 namespace deformlab::bench {
@@ -25,6 +26,10 @@ std::string describe(SceneKind k) {
     return "paper scene: the table2 experiment's (spring damping, ground, a sphere, the centre node dragged on its "
            "path, dt 50 us), from rest";
   return "idealised scene: 1 m, top corners pinned, undamped springs, no contact, no drag, dt 1 ms, from rest";
+}
+
+std::string title(const char* name) {
+  return std::string("deformlab-bench ") + name + " (build " + build_info()["git"].get<std::string>() + "):";
 }
 
 namespace {
