@@ -13,6 +13,9 @@
 #include "experiments/pipelines.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
+#if DEFORMLAB_HAVE_INTEROP
+#include "interop/shared_buffers.hpp"
+#endif
 
 namespace deformlab::bench {
 
@@ -37,6 +40,16 @@ Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   const Stats s = stats(time_steps(p, m, o.warmup_ms, o.warmup, o.reps, gl_bus()));
   if (!(p.max_displacement() >= 0.0)) throw std::runtime_error("the benchmark state diverged");
   return s;
+}
+
+// The memory glsl-compute's node buffers take when no memory option is given: CUDA's where
+// the machine has it (null: GL's own buffers).
+std::unique_ptr<gl::NodeMemory> default_memory() {
+#if DEFORMLAB_HAVE_INTEROP
+  const gl::CudaMemory cuda = interop::cuda_memory();
+  if (cuda.unavailable().empty()) return cuda.make();
+#endif
+  return nullptr;
 }
 
 // Two vec4 attributes copied by a vertex shader into two transform feedback buffers,
@@ -90,23 +103,35 @@ Stats time_passthrough(int n, const StepOptions& o) {
 }
 
 // glsl-compute's bare gather (shaders/bare_gather.comp) on an n x n cloth: step.comp's loads
-// and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong.
+// and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong; its
+// buffers where glsl-compute's node buffers are (the memory option's default here).
 Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   using namespace gl;
   const std::string defines = compute_tile_defines() + stencil_defines(false) + (verlet ? "#define PREVIOUS 1\n" : "");
   Program prog = make_program({{GL_COMPUTE_SHADER, "bare_gather.comp"}}, defines);
-  const std::vector<float> rest(std::size_t(n) * n * 4, 0.5f);
-  Buffer buf[2][3];
-  for (auto& state : buf)
-    for (Buffer& b : state) b = make_buffer(rest.size() * sizeof(float), rest.data());
+  std::unique_ptr<NodeMemory> memory = default_memory();
+  Buffer own[2][3];
+  GLuint buf[2][3];
+  const float half = 0.5f;
+  for (int c = 0; c < 2; ++c)
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t bytes = std::size_t(n) * n * 16;
+      if (memory) {
+        buf[c][a] = memory->add(bytes);
+      } else {
+        own[c][a] = make_buffer(bytes);
+        buf[c][a] = own[c][a].id();
+      }
+      glClearNamedBufferData(buf[c][a], GL_R32F, GL_RED, GL_FLOAT, &half);
+    }
   glUseProgram(prog.id());
   glUniform1i(0, n);
   int k = 0;
   const auto bind = [&] {
     const int c = k++ % 2;
     for (GLuint a = 0; a < 3; ++a) {
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, a, buf[c][a].id());
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a].id());
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, a, buf[c][a]);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a]);
     }
   };
   const auto dispatch = [&] {
@@ -145,6 +170,14 @@ void run_gl(const StepOptions& o) {
             << std::setw(14) << "compute fast" << std::setw(12) << "fast/bare" << "\n";
   std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms,sm_mhz_median,slowed_fraction");
   ClockTally clocks;
+  std::string memory;  // where the node buffers live, as the registry's pipelines chose
+  // The registry's pipelines, as `deformlab run` makes them.
+  auto make = [&](const char* name, const PipelineSetup& s) {
+    auto p = pipelines().find(name)->make(s);
+    const auto chosen = p->chosen_options();
+    if (const auto it = chosen.find("memory"); it != chosen.end()) memory = it->second;
+    return p;
+  };
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
@@ -154,18 +187,18 @@ void run_gl(const StepOptions& o) {
     Stats tf, compute, compute_fast;
     std::string neighbours;
     {
-      auto pipe = gl::make_tf_pipeline(setup);
+      auto pipe = make("glsl-tf", setup);
       neighbours = dynamic_cast<gl::GlPipeline&>(*pipe).neighbour_mode();
       tf = time_pipeline(*pipe, m, o);
     }
     {
-      auto pipe = gl::make_compute_pipeline(setup);
+      auto pipe = make("glsl-compute", setup);
       compute = time_pipeline(*pipe, m, o);
     }
     {
       PipelineSetup fast = setup;
       fast.options["math"] = "fast";
-      auto pipe = gl::make_compute_pipeline(fast);
+      auto pipe = make("glsl-compute", fast);
       compute_fast = time_pipeline(*pipe, m, o);
     }
     std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(16)
@@ -184,6 +217,9 @@ void run_gl(const StepOptions& o) {
             << clock_columns(s.clock) << "\n";
     }
   }
+  if (!memory.empty())
+    std::cout << "node buffers of glsl-tf, glsl-compute and the bare gather: memory=" << memory
+              << " (chosen for this machine)\n";
   print_clocks(std::cout, clocks, "timed steps");
 }
 

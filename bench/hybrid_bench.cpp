@@ -10,8 +10,8 @@
 #include "bench.hpp"
 #include "core/profiler.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
+#include "experiments/pipelines.hpp"
 #include "gl/context.hpp"
-#include "gl/pipelines_internal.hpp"
 #include "interop/calibrate.hpp"
 #include "interop/hybrid.hpp"
 
@@ -134,7 +134,7 @@ void run_hybrid(const HybridOptions& o) {
       print(fused);
       Row tf{n, "glsl-tf", "-"};
       Profiler prof;  // profiled as the hybrids are, so that the wall times compare
-      measure(*gl::make_tf_pipeline(setup), m, tf, &prof);
+      measure(*pipelines().find("glsl-tf")->make(setup), m, tf, &prof);
       print(tf);
     }
     for (const auto& u : o.updates)

@@ -8,6 +8,7 @@
 #include "cuda_kernels/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_GL
+#include "gl/gl_pipeline.hpp"
 #include "gl/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_INTEROP
@@ -44,9 +45,9 @@ const Known kKnown[] = {
      on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
     {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false), {"math"}},
     {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute),
-     {"window", "link_view", "math"}},
+     {"window", "link_view", "math", "memory"}},
     {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL", on(Engine::gl_transform_feedback),
-     {"link_view", "math"}},
+     {"link_view", "math", "memory"}},
     {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL",
      hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile", "math"}},
     {"hybrid-compute", "CUDA forces into GL buffers, compute-shader update", "CUDA and OpenGL",
@@ -63,7 +64,11 @@ PipelineRegistry build() {
   add_cuda_pipelines(built);
 #endif
 #if DEFORMLAB_HAVE_GL
-  add_gl_pipelines(built);
+#if DEFORMLAB_HAVE_INTEROP
+  add_gl_pipelines(built, interop::cuda_memory());
+#else
+  add_gl_pipelines(built, {});
+#endif
 #endif
 #if DEFORMLAB_HAVE_INTEROP
   add_hybrid_pipelines(built);

@@ -58,6 +58,17 @@ std::vector<Table> tables_of(const Sweep& sweep, bool by_pipeline) {
   return tables;
 }
 
+// Where the compute-shader copy ran, as calibrations since the GL pipelines' memory option record
+// it: " on memory=cuda (N GB/s on GL's buffers)", or nothing.
+std::string compute_copy_memory(const json& calibration) {
+  const json copy = calibration.value("compute_copy", json::object());
+  if (!copy.contains("memory")) return "";
+  std::string s = " on memory=" + copy["memory"].get<std::string>();
+  const json gl = calibration.value("compute_copy_gl_buffers", json::object());
+  if (gl.contains("GB_per_s")) s += " (" + fmt(gl["GB_per_s"].get<double>()) + " GB/s on GL's buffers)";
+  return s;
+}
+
 void write_setup(Report& r) {
   const json& xj = r.manifest["experiment"];
   r.md << "# " << r.name << "\n\n" << xj.value("description", std::string()) << "\n\n";
@@ -80,8 +91,8 @@ void write_setup(Report& r) {
   if (r.ceil.any()) {
     r.md << "- Calibration (`deformlab calibrate`, "
          << calibration.value("device", json::object()).value("name", std::string("?")) << "): CUDA copy "
-         << fmt(r.ceil.copy_gb_s) << " GB/s, compute-shader copy " << fmt(r.ceil.compute_copy_gb_s)
-         << " GB/s, transform feedback " << fmt(r.ceil.tf_vertices_s * 1e-6)
+         << fmt(r.ceil.copy_gb_s) << " GB/s, compute-shader copy " << fmt(r.ceil.compute_copy_gb_s) << " GB/s"
+         << compute_copy_memory(calibration) << ", transform feedback " << fmt(r.ceil.tf_vertices_s * 1e-6)
          << " M vertices/s, GL <-> CUDA hand-off floor " << fmt(r.ceil.floor_us) << " µs\n";
   } else {
     r.md << "- No calibration recorded: times are not shown against ceilings\n";

@@ -17,8 +17,8 @@ namespace {
 
 class ComputePipeline final : public GlPipeline {
  public:
-  ComputePipeline(const PipelineSetup& s, const SharedAllocator& shared)
-      : GlPipeline(s, shared ? "hybrid-compute" : "glsl-compute", shared) {
+  ComputePipeline(const PipelineSetup& s, const SharedAllocator& shared, const CudaMemory& cuda = {})
+      : GlPipeline(s, shared ? "hybrid-compute" : "glsl-compute", shared, cuda) {
     // step.comp's blocks: bindings 0-7, the stop-rule words (9), the posted word (10) and, with an
     // outside force stage, its accelerations (8).
     GLint blocks = 0, bindings = 0;
@@ -105,8 +105,8 @@ class ComputePipeline final : public GlPipeline {
 
 }  // namespace
 
-std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s) {
-  return std::make_unique<ComputePipeline>(s, nullptr);
+std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s, const CudaMemory& cuda) {
+  return std::make_unique<ComputePipeline>(s, nullptr, cuda);
 }
 
 std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared) {

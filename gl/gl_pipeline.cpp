@@ -92,6 +92,8 @@ std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::in
 
 void read_options(const PipelineOptions& o) {
   math_option(o);
+  if (const auto it = o.find("memory"); it != o.end() && it->second != "gl" && it->second != "cuda")
+    throw std::invalid_argument("option memory '" + it->second + "' is not one of gl, cuda");
   for (const char* name : {"window", "link_view"})
     if (const auto it = o.find(name); it != o.end() && !parse_count(it->second))
       throw std::invalid_argument(std::string("option ") + name + " '" + it->second + "' is not a count of 1 or more");
@@ -106,7 +108,7 @@ Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
   return {chunk, n * 16 * node_buffers + adjacency + chunk};
 }
 
-GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared)
+GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared, const CudaMemory& cuda)
     : name_(std::move(name)),
       shared_(std::move(shared)),
       m_(s.model),
@@ -127,6 +129,7 @@ GlPipeline::GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator
   if (adjacency) plan_link_views(s.options);
   require_memory(footprint(m_.size(), s.integrator, bool(shared_)).device);
   plan();
+  choose_memory(s.options, cuda);
   make_buffers();
   upload_params();
   if (adjacency) upload_adjacency();
@@ -204,6 +207,21 @@ void GlPipeline::bind_nodes(GLuint index, const NodeBuffer& b, int first, int co
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, index, b.id(), GLintptr(first) * 16, GLsizeiptr(count) * 16);
 }
 
+void GlPipeline::choose_memory(const PipelineOptions& o, const CudaMemory& cuda) {
+  read_options(o);
+  const auto it = o.find("memory");
+  if (it != o.end() && it->second == "gl") return;
+  const std::string why = cuda.make ? cuda.unavailable() : "this build has no CUDA-OpenGL interop";
+  if (it == o.end()) {
+    if (shared_) return;  // the hybrids' update: the interop mode decides where the shared states live
+    chosen_["memory"] = why.empty() ? "cuda" : "gl";
+    if (!why.empty()) return;
+  } else if (!why.empty()) {
+    throw std::invalid_argument(name_ + ": memory cuda is not available: " + why);
+  }
+  memory_ = cuda.make();
+}
+
 void GlPipeline::make_buffers() {
   const std::size_t bytes = std::size_t(n_) * 16;
   // The states forces are evaluated at (and the accelerations) belong to the outside
@@ -212,6 +230,8 @@ void GlPipeline::make_buffers() {
     NodeBuffer b;
     if (shared_ && forces_read)
       b.external = shared_(bytes, NodeRole::state);
+    else if (memory_)
+      b.external = memory_->add(bytes);
     else
       b.buf = make_buffer(bytes);
     if (n_ <= max_texels_) b.tex = make_texture_buffer(b.id(), GL_RGBA32F);  // else no pass reads it
@@ -319,7 +339,7 @@ void GlPipeline::set_state(const State& s) {
     throw std::invalid_argument("state size does not match the model");
   context();
   // A chunk at a time through one staging buffer, then a shader copy (see shaders/copy.comp:
-  // buffers of the external force stage may be memory imported from another API).
+  // node buffers may be memory imported from CUDA).
   const int chunk = int(std::min<std::int64_t>(kTransferChunkNodes, max_block_nodes_));
   std::vector<float> data(4 * std::size_t(std::min(chunk, n_)));
   const Buffer staging = make_buffer(data.size() * 4);

@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,20 @@ namespace deformlab::gl {
 enum class NodeRole { state, accelerations };
 using SharedAllocator = std::function<GLuint(std::size_t bytes, NodeRole role)>;
 
+// Where a GL pipeline's own node buffers live (option "memory"): "gl", GL's own buffers, or
+// "cuda", memory from CUDA's allocator imported into GL, which GL's passes reach faster on
+// large unordered meshes (docs/speed.md). The interop layer provides the latter.
+class NodeMemory {
+ public:
+  virtual ~NodeMemory() = default;
+  // A buffer of `bytes` (contents undefined), its GL name valid while this object lives.
+  virtual GLuint add(std::size_t bytes) = 0;
+};
+struct CudaMemory {
+  std::function<std::string()> unavailable;  // empty when usable here, else why not
+  std::function<std::unique_ptr<NodeMemory>()> make;
+};
+
 // A range of nodes one storage-buffer dispatch covers: it writes [first, first + count) and
 // reads [read_first, read_first + read_count), the written nodes and their springs' reach.
 struct NodeWindow {
@@ -31,7 +46,7 @@ struct NodeWindow {
 std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align);
 
 // Reads the options' values as far as they do not depend on the GL context (PipelineEntry::
-// read_options): math, and window and link_view as counts.
+// read_options): math, memory, and window and link_view as counts.
 void read_options(const PipelineOptions& o);
 
 // Host and GPU bytes of a GL pipeline beyond the model (with an outside force stage: its
@@ -67,6 +82,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   double take_displacement() override;
   std::string timing_method() const override { return spans_.method(); }
   std::unique_ptr<StepTimer> step_timer() override { return std::make_unique<QueryStepTimer>(); }
+  std::map<std::string, std::string> chosen_options() const override { return chosen_; }
 
   unsigned gl_position_buffer() override;
   // While profiled, each step's passes are one force+update span timed by the GL clock
@@ -81,7 +97,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   enum class PassKind { one, stage, result };
   struct NodeBuffer {
     Buffer buf;           // owned here, or
-    GLuint external = 0;  // owned by the external force stage
+    GLuint external = 0;  // owned by the outside force stage or by memory_
     Texture tex;          // texture buffer view (RGBA32F)
     GLuint id() const { return external ? external : buf.id(); }
   };
@@ -108,8 +124,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // With `shared`, the passes read accelerations that an outside force stage writes into
   // buffers it allocates, instead of evaluating forces. Options: "window", nodes per
   // storage-buffer window; "link_view", links per texture-buffer view of a general model's
-  // adjacency (default for both: the driver's limit); "math", exact or fast (core/pipeline.hpp).
-  GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared = {});
+  // adjacency (default for both: the driver's limit); "math", exact or fast (core/pipeline.hpp);
+  // "memory", gl or cuda (`cuda`'s; default: cuda where it is available, else gl).
+  GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared, const CudaMemory& cuda);
   // Throws std::invalid_argument naming the driver's limit when `texels` texels do not fit
   // in one texture buffer.
   void require_texels(std::int64_t texels, const std::string& what) const;
@@ -137,6 +154,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
   const std::string name_;
   const SharedAllocator shared_;
+  // The own node buffers' memory with memory=cuda (else null: GL's buffers). Declared before
+  // the buffers, so destroyed after them.
+  std::unique_ptr<NodeMemory> memory_;
   NodeBuffer forces_acc_;  // what the outside force stage writes
   std::array<NodeBuffer, 2> x_, v_, xp_;  // state sets, ping-pong (xp_: Verlet)
   // Runge-Kutta stages: sx_[k], sv_[k] the state of stage k + 1, sa_[k] the acceleration at stage k.
@@ -150,6 +170,8 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     Program prog;
     GLint drag_force_target, drag_next, has_prev;
   };
+  // memory_ and chosen_ from option "memory".
+  void choose_memory(const PipelineOptions& o, const CudaMemory& cuda);
   void make_buffers();
   void upload_params();
   void upload_adjacency();
@@ -164,6 +186,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // less free memory than `bytes`.
   void require_memory(std::int64_t bytes) const;
 
+  std::map<std::string, std::string> chosen_;
   const Model& m_;
   Params p_;
   const UpdateRule rule_;

@@ -1,11 +1,12 @@
 #include "pipelines.hpp"
 
 #include "context.hpp"
+#include "gl_pipeline.hpp"
 #include "pipelines_internal.hpp"
 
 namespace deformlab {
 
-void add_gl_pipelines(PipelineRegistry& r) {
+void add_gl_pipelines(PipelineRegistry& r, const gl::CudaMemory& cuda) {
   auto unavailable = [] { return gl::unavailable_reason(); };
   auto unsupported = [](const char* name) {
     return [name](Integrator i) {
@@ -18,12 +19,13 @@ void add_gl_pipelines(PipelineRegistry& r) {
   auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
   auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) { return gl::footprint(m, i, false); };
   // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows); "link_view":
-  // links per texture-buffer view of a mesh's adjacency; "math": exact or fast.
+  // links per texture-buffer view of a mesh's adjacency; "math": exact or fast; "memory": gl or cuda.
   r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,
-         unsupported("glsl-compute"), gl::make_compute_pipeline, {"window", "link_view", "math"}, footprint,
-         gl::read_options});
+         unsupported("glsl-compute"), [cuda](const PipelineSetup& s) { return gl::make_compute_pipeline(s, cuda); },
+         {"window", "link_view", "math", "memory"}, footprint, gl::read_options});
   r.add({"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", on(Engine::gl_transform_feedback),
-         unavailable, unsupported("glsl-tf"), gl::make_tf_pipeline, {"link_view", "math"}, footprint, gl::read_options});
+         unavailable, unsupported("glsl-tf"), [cuda](const PipelineSetup& s) { return gl::make_tf_pipeline(s, cuda); },
+         {"link_view", "math", "memory"}, footprint, gl::read_options});
 }
 
 }  // namespace deformlab

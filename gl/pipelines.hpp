@@ -4,7 +4,12 @@
 #include "core/pipeline.hpp"
 
 namespace deformlab {
+namespace gl {
+struct CudaMemory;
+}
 
-void add_gl_pipelines(PipelineRegistry& r);
+// `cuda` gives their node buffers CUDA's memory (option memory=cuda): the interop layer's, empty
+// in a build without it.
+void add_gl_pipelines(PipelineRegistry& r, const gl::CudaMemory& cuda);
 
 }  // namespace deformlab

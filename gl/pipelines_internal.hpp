@@ -10,8 +10,10 @@
 
 namespace deformlab::gl {
 
-std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s);
-std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s);
+// Their node buffers from `cuda` with option memory=cuda (and by default where it is available),
+// else GL's own.
+std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s, const CudaMemory& cuda = {});
+std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s, const CudaMemory& cuda = {});
 // The same passes reading each node's acceleration from buffers allocated by `shared` and
 // written by an outside force stage (the update passes of the hybrid pipelines).
 std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared);

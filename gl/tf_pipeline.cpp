@@ -11,8 +11,8 @@ namespace {
 
 class TfPipeline final : public GlPipeline {
  public:
-  TfPipeline(const PipelineSetup& s, const SharedAllocator& shared)
-      : GlPipeline(s, shared ? "hybrid" : "glsl-tf", shared) {
+  TfPipeline(const PipelineSetup& s, const SharedAllocator& shared, const CudaMemory& cuda = {})
+      : GlPipeline(s, shared ? "hybrid" : "glsl-tf", shared, cuda) {
     require_texels(n_, "the node states (read by the vertex shader)");
     GLint separate = 0;
     glGetIntegerv(GL_MAX_TRANSFORM_FEEDBACK_SEPARATE_ATTRIBS, &separate);
@@ -97,7 +97,9 @@ class TfPipeline final : public GlPipeline {
 
 }  // namespace
 
-std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s) { return std::make_unique<TfPipeline>(s, nullptr); }
+std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s, const CudaMemory& cuda) {
+  return std::make_unique<TfPipeline>(s, nullptr, cuda);
+}
 
 std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared) {
   return std::make_unique<TfPipeline>(s, shared);

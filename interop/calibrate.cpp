@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <numeric>
+#include <vector>
 
 #include "core/timed_work.hpp"
 #include "cuda_kernels/check.cuh"
@@ -83,16 +85,23 @@ nlohmann::json tf_rate(std::int64_t n, int reps, const std::string& bus) {
           {"sm_clock", to_json(w.clock)}};
 }
 
-nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus) {
+// Between buffers of `memory` (kept while it lives), or GL's own where it is null.
+nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus, gl::NodeMemory* memory) {
   const std::size_t bytes = std::size_t(n) * 16;
-  gl::Buffer a = gl::make_buffer(bytes), b = gl::make_buffer(bytes);
+  std::vector<gl::Buffer> own;
+  auto buffer = [&]() -> GLuint {
+    if (memory) return memory->add(bytes);
+    own.push_back(gl::make_buffer(bytes));
+    return own.back().id();
+  };
+  const GLuint a = buffer(), b = buffer();
   gl::Program prog = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   const GLuint groups = GLuint(std::min<std::int64_t>(65535, (n + 255) / 256));
   const TimedWork w = gl_timed(reps, bus, [&] {
     glUseProgram(prog.id());
     glUniform1i(gl::uniform(prog.id(), "u_n"), GLint(n));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, a.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, b.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, a);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, b);
     glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(0);
@@ -104,6 +113,7 @@ nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus) {
           {"ms", ms},
           {"GB_per_s", 2.0 * double(bytes) / (ms * 1e6)},
           {"what", "compute shader copying one vec4 per node between two storage buffers"},
+          {"memory", memory ? "cuda" : "gl"},
           {"method", method_words(gl::Timer().method(), w)},
           {"sm_clock", to_json(w.clock)}};
 }
@@ -223,8 +233,18 @@ nlohmann::json calibrate(const CalibrateOptions& o, std::ostream& log) {
   log << "  copy: " << j["copy"]["GB_per_s"].get<double>() << " GB/s\n";
   j["transform_feedback"] = tf_rate(o.tf_vertices, o.reps, d.pci_bus_id);
   log << "  transform feedback: " << j["transform_feedback"]["vertices_per_s"].get<double>() / 1e6 << " M vertices/s\n";
-  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id);
-  log << "  compute copy: " << j["compute_copy"]["GB_per_s"].get<double>() << " GB/s\n";
+  // The ceiling on the memory the GL pipelines' node buffers take by default; where that is
+  // CUDA's, the copy between GL's own buffers beside it.
+  const gl::CudaMemory cuda = cuda_memory();
+  std::unique_ptr<gl::NodeMemory> memory = cuda.unavailable().empty() ? cuda.make() : nullptr;
+  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, memory.get());
+  log << "  compute copy (memory=" << (memory ? "cuda" : "gl") << "): " << j["compute_copy"]["GB_per_s"].get<double>()
+      << " GB/s\n";
+  if (memory) {
+    memory.reset();
+    j["compute_copy_gl_buffers"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, nullptr);
+    log << "  compute copy (memory=gl): " << j["compute_copy_gl_buffers"]["GB_per_s"].get<double>() << " GB/s\n";
+  }
 
   // external-gpusync last: it brings up Vulkan, the one mode that touches a third API.
   j["hand_off"] = nlohmann::json::array();

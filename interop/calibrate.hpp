@@ -1,8 +1,9 @@
 // This device's ceilings, for reports to show every stage time against its own ceiling and
 // every hand-off against the floor: device-to-device copy bandwidth, pass-through transform
-// feedback vertex rate, compute-shader copy bandwidth, the bare hand-off cost of each
-// interop mode at a few buffer sizes, and the floor (a GPU-side semaphore ping-pong between
-// GL and CUDA with nothing else to do).
+// feedback vertex rate, compute-shader copy bandwidth (on the memory the GL pipelines' node
+// buffers take by default, and on GL's own buffers where that differs), the bare hand-off cost
+// of each interop mode at a few buffer sizes, and the floor (a GPU-side semaphore ping-pong
+// between GL and CUDA with nothing else to do).
 #pragma once
 #include <cstdint>
 #include <nlohmann/json.hpp>

@@ -186,35 +186,18 @@ class MapBuffers final : public SharedBuffers {
 
 class ExternalBuffers final : public SharedBuffers {
  public:
-  ExternalBuffers(Mode m, int device, CUstream_st* s) : SharedBuffers(m, device, s) {
+  ExternalBuffers(Mode m, int device, CUstream_st* s) : SharedBuffers(m, device, s), memory_(device) {
     if (m == Mode::external_gpusync) timeline_ = &shared_timeline(device);
   }
 
   ~ExternalBuffers() override {
-    glFinish();
     if (stream_) cudaStreamSynchronize(stream_);
   }
 
-  GLuint add(std::size_t bytes, CudaAccess) override {
-    Entry e;
-    e.memory = std::make_unique<ExportableAllocation>(device_, bytes);
-    glCreateMemoryObjectsEXT(1, &e.gl_memory);
-    // cuMemCreate memory is one allocation per buffer: GL must be told so. Imported without
-    // this flag, the NVIDIA driver accepts the fd without an error but the GL buffer does not
-    // see CUDA's memory (seen on the H100 at every size).
-    const GLint dedicated = GL_TRUE;
-    glMemoryObjectParameterivEXT(e.gl_memory, GL_DEDICATED_MEMORY_OBJECT_EXT, &dedicated);
-    glImportMemoryFdEXT(e.gl_memory, e.memory->size(), GL_HANDLE_TYPE_OPAQUE_FD_EXT, e.memory->export_fd());
-    GLuint id = 0;
-    glCreateBuffers(1, &id);
-    e.buffer = gl::Buffer(id);
-    glNamedBufferStorageMemEXT(id, GLsizeiptr(bytes), e.gl_memory, 0);
-    gl::check("importing CUDA memory into an OpenGL buffer (GL_EXT_memory_object_fd)");
-    entries_.emplace(id, std::move(e));
-    return id;
-  }
+  GLuint add(std::size_t bytes, CudaAccess) override { return memory_.add(bytes); }
 
   void to_cuda(const std::vector<GLuint>& buffers) override {
+    for (GLuint b : buffers) memory_.cuda_ptr(b);  // throws for a buffer not added here
     if (mode_ == Mode::external) {
       // The CPU waits for GL's commands so far, then queues the CUDA work.
       GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -225,7 +208,7 @@ class ExternalBuffers final : public SharedBuffers {
       return;
     }
     // GPU: GL signals the next value after its commands on these buffers; CUDA waits for it.
-    std::vector<GLuint> ids = gl_ids(buffers);
+    std::vector<GLuint> ids = buffers;
     const GLuint64 v = ++timeline_->value;
     glSemaphoreParameterui64vEXT(timeline_->gl, glext::kTimelineSemaphoreValue, &v);
     glSignalSemaphoreEXT(timeline_->gl, GLuint(ids.size()), ids.data(), 0, nullptr, nullptr);
@@ -236,11 +219,7 @@ class ExternalBuffers final : public SharedBuffers {
     handed_ = std::move(ids);
   }
 
-  void* cuda_ptr(GLuint b) const override {
-    auto it = entries_.find(b);
-    if (it == entries_.end()) throw std::logic_error("external: not a shared buffer");
-    return it->second.memory->ptr();
-  }
+  void* cuda_ptr(GLuint b) const override { return memory_.cuda_ptr(b); }
 
   void to_gl() override {
     if (mode_ == Mode::external) {
@@ -257,24 +236,7 @@ class ExternalBuffers final : public SharedBuffers {
   }
 
  private:
-  struct Entry {
-    std::unique_ptr<ExportableAllocation> memory;
-    GLuint gl_memory = 0;
-    gl::Buffer buffer;  // declared after gl_memory: deleted before it
-    Entry() = default;
-    Entry(Entry&& o) noexcept
-        : memory(std::move(o.memory)), gl_memory(std::exchange(o.gl_memory, 0)), buffer(std::move(o.buffer)) {}
-    ~Entry() {
-      buffer = gl::Buffer();
-      if (gl_memory) glDeleteMemoryObjectsEXT(1, &gl_memory);
-    }
-  };
-  std::vector<GLuint> gl_ids(const std::vector<GLuint>& buffers) const {
-    for (GLuint b : buffers)
-      if (!entries_.count(b)) throw std::logic_error("external: not a shared buffer");
-    return buffers;
-  }
-  std::map<GLuint, Entry> entries_;
+  CudaMemoryBuffers memory_;
   SharedTimeline* timeline_ = nullptr;  // external-gpusync
   std::vector<GLuint> handed_;
 };
@@ -356,6 +318,57 @@ class StagedBuffers final : public SharedBuffers {
 };
 
 }  // namespace
+
+struct CudaMemoryBuffers::Entry {
+  ExportableAllocation memory;
+  GLuint gl_memory = 0;
+  gl::Buffer buffer;  // declared after gl_memory: deleted before it
+  Entry(int device, std::size_t bytes) : memory(device, bytes) {}
+  ~Entry() {
+    buffer = gl::Buffer();
+    if (gl_memory) glDeleteMemoryObjectsEXT(1, &gl_memory);
+  }
+};
+
+CudaMemoryBuffers::CudaMemoryBuffers(int device) : device_(device) {}
+
+CudaMemoryBuffers::~CudaMemoryBuffers() {
+  glFinish();
+  entries_.clear();
+}
+
+GLuint CudaMemoryBuffers::add(std::size_t bytes) {
+  auto e = std::make_unique<Entry>(device_, bytes);
+  glCreateMemoryObjectsEXT(1, &e->gl_memory);
+  // cuMemCreate memory is one allocation per buffer: GL must be told so. Imported without
+  // this flag, the NVIDIA driver accepts the fd without an error but the GL buffer does not
+  // see CUDA's memory (seen on the H100 at every size).
+  const GLint dedicated = GL_TRUE;
+  glMemoryObjectParameterivEXT(e->gl_memory, GL_DEDICATED_MEMORY_OBJECT_EXT, &dedicated);
+  glImportMemoryFdEXT(e->gl_memory, e->memory.size(), GL_HANDLE_TYPE_OPAQUE_FD_EXT, e->memory.export_fd());
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  e->buffer = gl::Buffer(id);
+  glNamedBufferStorageMemEXT(id, GLsizeiptr(bytes), e->gl_memory, 0);
+  gl::check("importing CUDA memory into an OpenGL buffer (GL_EXT_memory_object_fd)");
+  entries_.emplace(id, std::move(e));
+  return id;
+}
+
+void* CudaMemoryBuffers::cuda_ptr(GLuint buffer) const {
+  const auto it = entries_.find(buffer);
+  if (it == entries_.end()) throw std::logic_error("not a buffer over CUDA's memory");
+  return it->second->memory.ptr();
+}
+
+gl::CudaMemory cuda_memory() {
+  return {[] { return unavailable(Mode::external); },
+          [] {
+            const int dev = cuda_device_of_gl();
+            check(cudaSetDevice(dev), "selecting the CUDA device behind the OpenGL context");
+            return std::make_unique<CudaMemoryBuffers>(dev);
+          }};
+}
 
 SharedBuffers::~SharedBuffers() {
   if (stream_) cudaStreamDestroy(stream_);

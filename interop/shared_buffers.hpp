@@ -14,11 +14,14 @@
 #include <GL/glew.h>
 
 #include <cstddef>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "gl/gl_pipeline.hpp"
 
 struct CUstream_st;
 
@@ -38,6 +41,29 @@ enum class CudaAccess { read, write };
 std::string unavailable(Mode m);
 // The CUDA device behind the current GL context; throws std::invalid_argument if none.
 int cuda_device_of_gl();
+
+class ExportableAllocation;
+
+// GL buffers over memory from CUDA's allocator on `device` (cuMemCreate, exported as a POSIX fd
+// and imported with GL_EXT_memory_object_fd), owned here: the external modes' buffers, and the
+// GL pipelines' node buffers with memory=cuda.
+class CudaMemoryBuffers final : public gl::NodeMemory {
+ public:
+  explicit CudaMemoryBuffers(int device);
+  ~CudaMemoryBuffers() override;  // waits for GL's commands (glFinish) before freeing
+  GLuint add(std::size_t bytes) override;
+  // CUDA's pointer to a buffer added here; throws std::logic_error for another.
+  void* cuda_ptr(GLuint buffer) const;
+
+ private:
+  struct Entry;
+  int device_;
+  std::map<GLuint, std::unique_ptr<Entry>> entries_;
+};
+
+// The GL pipelines' memory=cuda: available where interop mode external is (a CUDA device behind
+// the GL context, GL memory objects, exportable CUDA memory).
+gl::CudaMemory cuda_memory();
 
 class SharedBuffers {
  public:

@@ -1,12 +1,15 @@
 // Failures are reported where they happen: a broken shader with its name and the driver's
 // log (and a non-zero exit of the command), no EGL display or a bad option value with one clear
 // error (exit 2).
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sys/wait.h>
+#include <utility>
+#include <vector>
 
 #include "gl_test_support.hpp"
 #include "gl/objects.hpp"
@@ -86,17 +89,25 @@ TEST(GlErrors, UnknownGlDeviceIsBadInput) {
 }
 
 // A pipeline option's bad value is bad input like the flags' (tests/unit/bad_input_test.cpp,
-// which runs without GL): one line, exit 2, nothing written.
-TEST(GlErrors, BadMathValueIsBadInput) {
+// which runs without GL): one line, exit 2, nothing written. So is memory=cuda on a software
+// renderer, which has no CUDA device behind it.
+TEST(GlErrors, BadOptionValuesAreBadInput) {
   DEFORMLAB_REQUIRE_GL();
   for (const char* name : {"glsl-tf", "glsl-compute"}) {
-    const auto dir = temp_dir("math");
-    const Command c = run_deformlab(
-        "", std::string("run -p ") + name + " --grid 8x8 --steps 1 --option math=foo -o '" + (dir / "out").string() + "'");
-    EXPECT_EQ(c.exit_code, 2) << c.output;
-    EXPECT_EQ(c.output, std::string("deformlab: error: ") + name + ": option math 'foo' is not exact or fast\n");
-    EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
-    std::filesystem::remove_all(dir);
+    std::vector<std::pair<std::string, std::string>> cases = {
+        {"math=foo", std::string(name) + ": option math 'foo' is not exact or fast\n"},
+        {"memory=host", std::string(name) + ": option memory 'host' is not one of gl, cuda\n"}};
+    if (gl::context().software) cases.push_back({"memory=cuda", std::string(name) + ": memory cuda is not available: "});
+    for (const auto& [option, error] : cases) {
+      const auto dir = temp_dir("option");
+      const Command c = run_deformlab("", std::string("run -p ") + name + " --grid 8x8 --steps 1 --option " + option +
+                                              " -o '" + (dir / "out").string() + "'");
+      EXPECT_EQ(c.exit_code, 2) << c.output;
+      EXPECT_TRUE(c.output.starts_with("deformlab: error: " + error)) << c.output;
+      EXPECT_EQ(std::count(c.output.begin(), c.output.end(), '\n'), 1) << c.output;
+      EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
+      std::filesystem::remove_all(dir);
+    }
   }
 }
 

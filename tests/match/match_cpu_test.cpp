@@ -72,6 +72,8 @@ const OptionValues kOptionValues[] = {
     // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
     {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},
     {"math", {"fast"}, {0, 6, 7, 9}, kOnePassAndRk4},  // exact is the default: every case above runs it
+    // GL's own buffers: the default where CUDA's memory can be imported (every case above there)
+    {"memory", {"gl"}, {0, 6, 8}},
 };
 
 struct Case {

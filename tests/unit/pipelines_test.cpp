@@ -29,6 +29,7 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_EQ(r.find("cuda-tiled")->options, (std::vector<std::string>{"tile", "math"}));
   EXPECT_EQ(r.find("cuda-temporal")->options, (std::vector<std::string>{"tile", "steps_per_launch", "math"}));
   EXPECT_EQ(r.find("hybrid")->options, (std::vector<std::string>{"interop", "force", "tile", "math"}));
+  EXPECT_EQ(r.find("glsl-tf")->options, (std::vector<std::string>{"link_view", "math", "memory"}));
   for (const auto& e : r.all()) EXPECT_EQ(e.traits.grids_only, e.name == "cuda-temporal") << e.name;
   // Fast math compares by rounding; exact keeps the trait.
   EXPECT_EQ(cpu_match(*r.find("cuda-fused"), {{"math", "fast"}}), CpuMatch::rounding);
@@ -135,7 +136,7 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
       {"cuda-temporal", {{"steps_per_launch", "9"}}},
       {"cuda-temporal", {{"tile", "40x"}}},        {"glsl-compute", {{"window", "0"}}},
       {"glsl-tf", {{"link_view", "many"}}},        {"hybrid", {{"interop", "telepathy"}}},
-      {"hybrid-compute", {{"force", "fused"}}}};
+      {"hybrid-compute", {{"force", "fused"}}},    {"glsl-compute", {{"memory", "host"}}}};
   for (const auto& [name, o] : bad) {
     if (r.find(name)->read_options) {
       EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;

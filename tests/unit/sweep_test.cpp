@@ -295,7 +295,8 @@ TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
       "sweep": {"sizes": [64], "pipelines": ["cuda-fused", "hybrid"], "options": [{"interop": "map"}]}})");
   const json calibration = {{"device", {{"name", "test gpu"}}},
                             {"copy", {{"GB_per_s", 1000.0}}},
-                            {"compute_copy", {{"GB_per_s", 500.0}}},
+                            {"compute_copy", {{"GB_per_s", 500.0}, {"memory", "cuda"}}},
+                            {"compute_copy_gl_buffers", {{"GB_per_s", 400.0}}},
                             {"transform_feedback", {{"vertices_per_s", 1e8}}},
                             {"floor", {{"us_per_hand_off", 100.0}}}};
   json manifest = {{"experiment", experiment},
@@ -324,7 +325,10 @@ TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
   manifest["calibration"] = calibration;
   std::ofstream(dir_ / "manifest.json") << manifest.dump();
   md = slurp(write_report(dir_));
-  EXPECT_NE(md.find("Calibration (`deformlab calibrate`, test gpu): CUDA copy 1000.0 GB/s"), std::string::npos) << md;
+  EXPECT_NE(md.find("Calibration (`deformlab calibrate`, test gpu): CUDA copy 1000.0 GB/s, compute-shader copy "
+                    "500.0 GB/s on memory=cuda (400.0 GB/s on GL's buffers), transform feedback"),
+            std::string::npos)
+      << md;
   EXPECT_NE(md.find("| grid | cuda-fused | hybrid [interop=map] |\n|---|---|---|\n| 64² | 0.000262 (2.6%) | 0.241 (48%) |"),
             std::string::npos)
       << md;
