@@ -125,7 +125,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // buffers it allocates, instead of evaluating forces. Options: "window", nodes per
   // storage-buffer window; "link_view", links per texture-buffer view of a general model's
   // adjacency (default for both: the driver's limit); "math", exact or fast (core/pipeline.hpp);
-  // "memory", gl or cuda (`cuda`'s; default: cuda where it is available, else gl).
+  // "memory", gl or cuda (the latter from `cuda`; default: cuda where `cuda` is available, else gl).
   GlPipeline(const PipelineSetup& s, std::string name, SharedAllocator shared, const CudaMemory& cuda);
   // Throws std::invalid_argument naming the driver's limit when `texels` texels do not fit
   // in one texture buffer.
