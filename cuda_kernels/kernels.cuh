@@ -23,7 +23,9 @@ struct Stencil {
   P::StencilEntry e[kLatticeStencil];
 };
 
-struct Link {  // one CSR entry: the spring's other end and its constants
+// One CSR entry: the spring's other end and its constants. Aligned to its 16 bytes, so that a
+// gather loads it with one vector load instead of four.
+struct alignas(16) Link {
   int node;
   float rest, k, kd;
 };
