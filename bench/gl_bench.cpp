@@ -42,14 +42,14 @@ Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   return s;
 }
 
-// The memory glsl-compute's node buffers take when no memory option is given: CUDA's where
-// the machine has it (null: GL's own buffers).
+// The memory glsl-compute's node buffers take when no memory option is given (null: GL's own
+// buffers).
 std::unique_ptr<gl::NodeMemory> default_memory() {
 #if DEFORMLAB_HAVE_INTEROP
-  const gl::CudaMemory cuda = interop::cuda_memory();
-  if (cuda.unavailable().empty()) return cuda.make();
-#endif
+  return interop::cuda_memory().make_default();
+#else
   return nullptr;
+#endif
 }
 
 // Two vec4 attributes copied by a vertex shader into two transform feedback buffers,

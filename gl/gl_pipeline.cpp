@@ -207,19 +207,26 @@ void GlPipeline::bind_nodes(GLuint index, const NodeBuffer& b, int first, int co
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, index, b.id(), GLintptr(first) * 16, GLsizeiptr(count) * 16);
 }
 
+std::string CudaMemory::why_not() const {
+  return make ? unavailable() : "this build has no CUDA-OpenGL interop";
+}
+
+std::unique_ptr<NodeMemory> CudaMemory::make_default() const {
+  return why_not().empty() ? make() : nullptr;
+}
+
 void GlPipeline::choose_memory(const PipelineOptions& o, const CudaMemory& cuda) {
   read_options(o);
   const auto it = o.find("memory");
-  if (it != o.end() && it->second == "gl") return;
-  const std::string why = cuda.make ? cuda.unavailable() : "this build has no CUDA-OpenGL interop";
   if (it == o.end()) {
     if (shared_) return;  // the hybrids' update: the interop mode decides where the shared states live
-    chosen_["memory"] = why.empty() ? "cuda" : "gl";
-    if (!why.empty()) return;
-  } else if (!why.empty()) {
-    throw std::invalid_argument(name_ + ": memory cuda is not available: " + why);
+    memory_ = cuda.make_default();
+    chosen_["memory"] = memory_ ? "cuda" : "gl";
+  } else if (it->second == "cuda") {
+    const std::string why = cuda.why_not();
+    if (!why.empty()) throw std::invalid_argument(name_ + ": memory cuda is not available: " + why);
+    memory_ = cuda.make();
   }
-  memory_ = cuda.make();
 }
 
 void GlPipeline::make_buffers() {

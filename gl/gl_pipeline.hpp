@@ -32,6 +32,12 @@ class NodeMemory {
 struct CudaMemory {
   std::function<std::string()> unavailable;  // empty when usable here, else why not
   std::function<std::unique_ptr<NodeMemory>()> make;
+
+  // Empty when this build has CUDA's memory and this machine can use it, else why not.
+  std::string why_not() const;
+  // The memory a GL pipeline takes when no option names one: CUDA's where usable, else
+  // null (GL's own buffers).
+  std::unique_ptr<NodeMemory> make_default() const;
 };
 
 // A range of nodes one storage-buffer dispatch covers: it writes [first, first + count) and

@@ -235,8 +235,7 @@ nlohmann::json calibrate(const CalibrateOptions& o, std::ostream& log) {
   log << "  transform feedback: " << j["transform_feedback"]["vertices_per_s"].get<double>() / 1e6 << " M vertices/s\n";
   // The ceiling on the memory the GL pipelines' node buffers take by default; where that is
   // CUDA's, the copy between GL's own buffers beside it.
-  const gl::CudaMemory cuda = cuda_memory();
-  std::unique_ptr<gl::NodeMemory> memory = cuda.unavailable().empty() ? cuda.make() : nullptr;
+  std::unique_ptr<gl::NodeMemory> memory = cuda_memory().make_default();
   j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, memory.get());
   log << "  compute copy (memory=" << (memory ? "cuda" : "gl") << "): " << j["compute_copy"]["GB_per_s"].get<double>()
       << " GB/s\n";
