@@ -7,7 +7,8 @@
 # to run, default all but timing, scale, endurance and speed),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
-# LABELS (the tests part's ctest -L regex, default every label), ARCHIVE (see the end),
+# LABELS (the tests part's ctest -L regex, default every label), SANITIZERS and MATCH_SHARDS (the
+# sanitizers part's tools and how many shards its match set runs in), ARCHIVE (see the end),
 # BASE_BENCH (a deformlab-bench of an earlier build: its cuda and gl rows are measured beside
 # this build's in the same session, for an A/B comparison), BASE_APP (its deformlab: the
 # timing part's experiment cells again).
@@ -56,13 +57,15 @@ fi
 cuda_tests="$build/tests/cuda/deformlab_cuda_tests"
 match_tests="$build/tests/match/deformlab_match_tests"
 bench="$build/bench/deformlab-bench"
-# The four tools run side by side, each on three sets at once (the CUDA tests, the bench's own
-# kernel beside the fused rows, the match tests), so that the part fits a 10-minute limit on one
-# command. On the H100: one after another the tools took 9 min 18 s without the bench; side by
-# side with the sets in turn, 9 min 17 s (racecheck's CUDA tests 180 s, its match tests 342 s);
-# all twelve at once, 6 min 49 s.
+# The four tools run side by side, each on its sets at once (the CUDA tests, the bench's own
+# kernel beside the fused rows, the match tests in MATCH_SHARDS gtest shards, default 4), so that
+# the part fits a 10-minute limit on one command. On the H100, the match set unsharded: all twelve
+# at once took 6 min 49 s on 8f91918; on 35dedc8 they ran past 10 minutes, racecheck's match set
+# alone 595 s for 149 of its 187 tests (cuda-temporal's and cuda-tiled's RK4 cases 8-14 s each
+# under racecheck), memcheck's 374 s and synccheck's 300 s. SANITIZERS names the tools to run
+# (default "memcheck racecheck synccheck initcheck").
 if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev/null; then
-  tools=(memcheck racecheck synccheck initcheck)
+  read -ra tools <<<"${SANITIZERS:-memcheck racecheck synccheck initcheck}"
   for tool in "${tools[@]}"; do
     compute-sanitizer --tool "$tool" "$cuda_tests" \
       --gtest_filter='CudaConstraints*:CudaPipeline.Energy*:CudaPipeline.MaxDisplacement*:CudaTemporal*' \
@@ -72,14 +75,17 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
         --graph-sizes 64 --temporal-sizes 64 --steps-per-launch 1 --warmup-ms 0 \
         >"$out/sanitizer-$tool-bench.log" 2>&1 &
     fi
-    compute-sanitizer --tool "$tool" "$match_tests" \
-      --gtest_filter='*/cuda_*cloth37x53*:*/cuda_fused_*cloth32_math_fast:*/cuda_fused_*contact37x53_math_fast:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*' \
-      >"$out/sanitizer-$tool-match.log" 2>&1 &
+    shards=${MATCH_SHARDS:-4}
+    for ((i = 0; i < shards; ++i)); do
+      GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i compute-sanitizer --tool "$tool" "$match_tests" \
+        --gtest_filter='*/cuda_*cloth37x53*:*/cuda_fused_*cloth32_math_fast:*/cuda_fused_*contact37x53_math_fast:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*' \
+        >"$out/sanitizer-$tool-match-$i.log" 2>&1 &
+    done
   done
   wait
   for tool in "${tools[@]}"; do
     logs=("$out/sanitizer-$tool"-*.log)
-    summary+=("$tool: $(cat "${logs[@]}" | grep -cF '[       OK ]') tests passed; $(cat "${logs[@]}" |
+    summary+=("$tool: $(cat "${logs[@]}" | grep -cF '[       OK ]') of $(cat "${logs[@]}" | grep -c '^\[ RUN') tests passed; $(cat "${logs[@]}" |
       grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' | sort | uniq -c | tr -s ' ' | tr '\n' ' ')")
   done
 fi
