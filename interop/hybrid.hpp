@@ -24,7 +24,7 @@ struct HybridOptions {
 
 // The interop mode the hybrids run when none is given: external-gpusync where this machine has it,
 // else map. Its buffers come from CUDA's allocator: on unordered meshes the force kernels' gathers
-// take 1.8-4.1x as long on GL's buffers (map), and its hand-offs are the cheapest (README, Meshes).
+// take 1.8-4.1x as long on GL's buffers (map), and its hand-offs are the cheapest (docs/meshes.md).
 Mode default_mode();
 // Reads the pipeline options `interop`, `force`, `tile` and `math` (throws std::invalid_argument on a
 // bad value).

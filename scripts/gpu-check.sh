@@ -3,8 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments timing scale endurance speed"
-# to run, default all but timing, scale, endurance and speed),
+# Environment: PARTS (which of "tests sanitizers bench experiments timing mesh scale endurance speed"
+# to run, default all but timing, mesh, scale, endurance and speed),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # LABELS (the tests part's ctest -L regex, default every label), SANITIZERS and MATCH_SHARDS (the
