@@ -61,10 +61,22 @@ Experiment load_experiment(const std::string& path) {
 }
 
 Experiment load_experiment_by_name(const std::string& path_or_name) {
-  if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos)
+  if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos) {
     if (const auto text = experiment_files::find(path_or_name + ".json"))
       return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_data_dir());
+    std::error_code ec;
+    if (!std::filesystem::exists(path_or_name, ec))
+      throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name +
+                                  "' (built in: " + builtin_experiment_names() + ")");
+  }
   return load_experiment(path_or_name);
+}
+
+std::string builtin_experiment_names() {
+  std::string names;
+  for (std::string_view file : experiment_files::names())
+    if (file.ends_with(".json")) names += (names.empty() ? "" : ", ") + std::string(file.substr(0, file.size() - 5));
+  return names;
 }
 
 std::string builtin_data_dir() {

@@ -24,7 +24,11 @@ Experiment parse_experiment(const std::string& text, const std::string& where, c
 Experiment load_experiment(const std::string& path);
 // A path to an experiment file, or the name of one built into the binary ("table1"). A
 // built-in experiment's mesh files are taken from the source tree's data/ (builtin_data_dir).
+// A name that is neither is bad input naming the built-in ones.
 Experiment load_experiment_by_name(const std::string& path_or_name);
+// The names of the experiments built into the binary (experiments/*.json), comma-separated:
+// "gl-memory, interop, ...".
+std::string builtin_experiment_names();
 // The data/ folder of the source tree this binary was built in: the first folder above the
 // running executable that holds data/ and experiments/ (a build inside a tree, wherever the
 // tree was moved), else the source tree it was configured from.
