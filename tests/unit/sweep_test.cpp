@@ -155,6 +155,20 @@ TEST(Report, CellLabels) {
   EXPECT_EQ(report::cell_label(json{{"model", "bunny"}}), "bunny");
 }
 
+// The built-in experiments are the source tree's experiments/*.json, each loading by its name,
+// and the names the CLI's help and its bad-input line give are theirs.
+TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
+  std::set<std::string> files;
+  for (const auto& e : fs::directory_iterator(fs::path(builtin_data_dir()).parent_path() / "experiments"))
+    if (e.path().extension() == ".json") files.insert(e.path().stem().string());
+  ASSERT_GE(files.size(), 11u);
+  std::set<std::string> named;
+  std::stringstream list(builtin_experiment_names());
+  for (std::string n; std::getline(list >> std::ws, n, ',');) named.insert(n);
+  EXPECT_EQ(named, files);
+  for (const std::string& n : files) EXPECT_EQ(load_experiment_by_name(n).name, n);
+}
+
 TEST_F(SweepTest, MeshesExperimentCells) {
   const Experiment x = load_experiment_by_name("meshes");
   const auto all = cells(*parse_sweep(x.raw, "meshes"));
