@@ -42,13 +42,12 @@ Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   return s;
 }
 
-// The memory glsl-compute's node buffers take when no memory option is given (null: GL's own
-// buffers).
+// The memory glsl-compute's node buffers take when no memory option is given.
 std::unique_ptr<gl::NodeMemory> default_memory() {
 #if DEFORMLAB_HAVE_INTEROP
   return interop::cuda_memory().make_default();
 #else
-  return nullptr;
+  return std::make_unique<gl::GlBufferMemory>();
 #endif
 }
 
@@ -110,18 +109,11 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   const std::string defines = compute_tile_defines() + stencil_defines(false) + (verlet ? "#define PREVIOUS 1\n" : "");
   Program prog = make_program({{GL_COMPUTE_SHADER, "bare_gather.comp"}}, defines);
   std::unique_ptr<NodeMemory> memory = default_memory();
-  Buffer own[2][3];
   GLuint buf[2][3];
   const float half = 0.5f;
   for (int c = 0; c < 2; ++c)
     for (int a = 0; a < 3; ++a) {
-      const std::size_t bytes = std::size_t(n) * n * 16;
-      if (memory) {
-        buf[c][a] = memory->add(bytes);
-      } else {
-        own[c][a] = make_buffer(bytes);
-        buf[c][a] = own[c][a].id();
-      }
+      buf[c][a] = memory->add(std::size_t(n) * n * 16);
       glClearNamedBufferData(buf[c][a], GL_R32F, GL_RED, GL_FLOAT, &half);
     }
   glUseProgram(prog.id());

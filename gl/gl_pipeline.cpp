@@ -211,21 +211,30 @@ std::string CudaMemory::why_not() const {
   return make ? unavailable() : "this build has no CUDA-OpenGL interop";
 }
 
+GLuint GlBufferMemory::add(std::size_t bytes) {
+  buffers_.push_back(make_buffer(bytes));
+  return buffers_.back().id();
+}
+
 std::unique_ptr<NodeMemory> CudaMemory::make_default() const {
-  return why_not().empty() ? make() : nullptr;
+  if (why_not().empty()) return make();
+  return std::make_unique<GlBufferMemory>();
 }
 
 void GlPipeline::choose_memory(const PipelineOptions& o, const CudaMemory& cuda) {
   read_options(o);
   const auto it = o.find("memory");
-  if (it == o.end()) {
-    if (shared_) return;  // the hybrids' update: the interop mode decides where the shared states live
+  if (it == o.end() && !shared_) {
     memory_ = cuda.make_default();
-    chosen_["memory"] = memory_ ? "cuda" : "gl";
-  } else if (it->second == "cuda") {
+    chosen_["memory"] = memory_->name();
+  } else if (it != o.end() && it->second == "cuda") {
     const std::string why = cuda.why_not();
     if (!why.empty()) throw std::invalid_argument(name_ + ": memory cuda is not available: " + why);
     memory_ = cuda.make();
+  } else {
+    // memory=gl, or the hybrids' update by default: the interop mode decides where the shared
+    // states live, and the update's own buffers are GL's.
+    memory_ = std::make_unique<GlBufferMemory>();
   }
 }
 
@@ -235,12 +244,7 @@ void GlPipeline::make_buffers() {
   // force stage when there is one.
   auto node_buffer = [&](bool forces_read) {
     NodeBuffer b;
-    if (shared_ && forces_read)
-      b.external = shared_(bytes, NodeRole::state);
-    else if (memory_)
-      b.external = memory_->add(bytes);
-    else
-      b.buf = make_buffer(bytes);
+    b.buffer = shared_ && forces_read ? shared_(bytes, NodeRole::state) : memory_->add(bytes);
     if (n_ <= max_texels_) b.tex = make_texture_buffer(b.id(), GL_RGBA32F);  // else no pass reads it
     return b;
   };
@@ -255,7 +259,7 @@ void GlPipeline::make_buffers() {
     sa_[k] = node_buffer(false);
   }
   if (shared_) {
-    forces_acc_.external = shared_(bytes, NodeRole::accelerations);
+    forces_acc_.buffer = shared_(bytes, NodeRole::accelerations);
     if (n_ <= max_texels_) forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
   }
 }

@@ -28,6 +28,17 @@ class NodeMemory {
   virtual ~NodeMemory() = default;
   // A buffer of `bytes` (contents undefined), its GL name valid while this object lives.
   virtual GLuint add(std::size_t bytes) = 0;
+  // The option's value for this memory: "gl" or "cuda".
+  virtual const char* name() const = 0;
+};
+// memory=gl: GL's own buffers.
+class GlBufferMemory final : public NodeMemory {
+ public:
+  GLuint add(std::size_t bytes) override;
+  const char* name() const override { return "gl"; }
+
+ private:
+  std::vector<Buffer> buffers_;
 };
 struct CudaMemory {
   std::function<std::string()> unavailable;  // empty when usable here, else why not
@@ -35,8 +46,7 @@ struct CudaMemory {
 
   // Empty when this build has CUDA's memory and this machine can use it, else why not.
   std::string why_not() const;
-  // The memory a GL pipeline takes when no option names one: CUDA's where usable, else
-  // null (GL's own buffers).
+  // The memory a GL pipeline takes when no option names one: CUDA's where usable, else GL's.
   std::unique_ptr<NodeMemory> make_default() const;
 };
 
@@ -102,10 +112,9 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // the one-pass rule (one), the next stage state (stage) or the step's result (result).
   enum class PassKind { one, stage, result };
   struct NodeBuffer {
-    Buffer buf;           // owned here, or
-    GLuint external = 0;  // owned by the outside force stage or by memory_
-    Texture tex;          // texture buffer view (RGBA32F)
-    GLuint id() const { return external ? external : buf.id(); }
+    GLuint buffer = 0;  // owned by memory_ or by the outside force stage
+    Texture tex;        // texture buffer view (RGBA32F)
+    GLuint id() const { return buffer; }
   };
   // What one pass reads and writes (besides the earlier stages' slopes, bound as textures
   // for both pipelines). s0: the current state (and Verlet's previous positions); src: the
@@ -160,8 +169,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   std::vector<NodeWindow> windows_;  // of the storage-buffer passes
   const std::string name_;
   const SharedAllocator shared_;
-  // The own node buffers' memory with memory=cuda (else null: GL's buffers). Declared before
-  // the buffers, so destroyed after them.
+  // The own node buffers' memory. Declared before the buffers, so destroyed after them.
   std::unique_ptr<NodeMemory> memory_;
   NodeBuffer forces_acc_;  // what the outside force stage writes
   std::array<NodeBuffer, 2> x_, v_, xp_;  // state sets, ping-pong (xp_: Verlet)

@@ -85,16 +85,10 @@ nlohmann::json tf_rate(std::int64_t n, int reps, const std::string& bus) {
           {"sm_clock", to_json(w.clock)}};
 }
 
-// Between buffers of `memory` (kept while it lives), or GL's own where it is null.
-nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus, gl::NodeMemory* memory) {
+// Between two buffers of `memory`.
+nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus, gl::NodeMemory& memory) {
   const std::size_t bytes = std::size_t(n) * 16;
-  std::vector<gl::Buffer> own;
-  auto buffer = [&]() -> GLuint {
-    if (memory) return memory->add(bytes);
-    own.push_back(gl::make_buffer(bytes));
-    return own.back().id();
-  };
-  const GLuint a = buffer(), b = buffer();
+  const GLuint a = memory.add(bytes), b = memory.add(bytes);
   gl::Program prog = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});
   const GLuint groups = GLuint(std::min<std::int64_t>(65535, (n + 255) / 256));
   const TimedWork w = gl_timed(reps, bus, [&] {
@@ -113,7 +107,7 @@ nlohmann::json compute_copy(std::int64_t n, int reps, const std::string& bus, gl
           {"ms", ms},
           {"GB_per_s", 2.0 * double(bytes) / (ms * 1e6)},
           {"what", "compute shader copying one vec4 per node between two storage buffers"},
-          {"memory", memory ? "cuda" : "gl"},
+          {"memory", memory.name()},
           {"method", method_words(gl::Timer().method(), w)},
           {"sm_clock", to_json(w.clock)}};
 }
@@ -236,12 +230,13 @@ nlohmann::json calibrate(const CalibrateOptions& o, std::ostream& log) {
   // The ceiling on the memory the GL pipelines' node buffers take by default; where that is
   // CUDA's, the copy between GL's own buffers beside it.
   std::unique_ptr<gl::NodeMemory> memory = cuda_memory().make_default();
-  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, memory.get());
-  log << "  compute copy (memory=" << (memory ? "cuda" : "gl") << "): " << j["compute_copy"]["GB_per_s"].get<double>()
+  j["compute_copy"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, *memory);
+  log << "  compute copy (memory=" << memory->name() << "): " << j["compute_copy"]["GB_per_s"].get<double>()
       << " GB/s\n";
-  if (memory) {
+  if (std::string_view(memory->name()) != "gl") {
     memory.reset();
-    j["compute_copy_gl_buffers"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, nullptr);
+    gl::GlBufferMemory gl_buffers;
+    j["compute_copy_gl_buffers"] = compute_copy(o.compute_nodes, o.reps, d.pci_bus_id, gl_buffers);
     log << "  compute copy (memory=gl): " << j["compute_copy_gl_buffers"]["GB_per_s"].get<double>() << " GB/s\n";
   }
 

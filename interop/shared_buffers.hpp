@@ -52,6 +52,7 @@ class CudaMemoryBuffers final : public gl::NodeMemory {
   explicit CudaMemoryBuffers(int device);
   ~CudaMemoryBuffers() override;  // waits for GL's commands (glFinish) before freeing
   GLuint add(std::size_t bytes) override;
+  const char* name() const override { return "cuda"; }
   // CUDA's pointer to a buffer added here; throws std::logic_error for another.
   void* cuda_ptr(GLuint buffer) const;
 
