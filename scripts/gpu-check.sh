@@ -15,6 +15,9 @@
 # On the H100 the parts took (build 8f91918): tests 5.3 min (JOBS=8), sanitizers 8.6, mesh about
 # 3.5 (28 runs, each loading a 1 M-node mesh and warming up for a second); timing and mesh
 # together passed 10 minutes, so run them as separate commands where one is limited to that.
+# On 2c35002: tests 6.4 min (JOBS=10); sanitizers with SANITIZERS="racecheck synccheck" 6.5 (its
+# longest job racecheck on the CUDA tests, 388 s, 225 of them on CUDA-temporal's exact-match
+# test), with "memcheck initcheck" 0.8.
 # On b1c55d7 (its bench warming each case up for a second) timing ran past 9.5 minutes: its bench
 # spent 3.6 of them on 8192^2 cuda-temporal cases, now left out, and glsl-tf's check runs 4.4 on
 # 2000 steps each, now 200: on dbe6930 it took 3.5 minutes, and the tests part (JOBS=8) 5.3.
