@@ -76,7 +76,7 @@ class ComputePipeline final : public GlPipeline {
     }
     for (const NodeWindow& w : windows_) {
       for (int k = 0; k < 5; ++k)
-        if (in[k]->id()) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
+        if (in[k]->id) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
       for (int k = 0; k < io.outputs; ++k) bind_nodes(GLuint(5 + k), *io.out[k], w.first, w.count);
       if (io.forces_acc) bind_nodes(8, *io.forces_acc, w.read_first, w.read_count);
       glUniform1i(kFirst, w.first);

@@ -204,7 +204,7 @@ void GlPipeline::plan_link_views(const PipelineOptions& o) {
 }
 
 void GlPipeline::bind_nodes(GLuint index, const NodeBuffer& b, int first, int count) {
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, index, b.id(), GLintptr(first) * 16, GLsizeiptr(count) * 16);
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, index, b.id, GLintptr(first) * 16, GLsizeiptr(count) * 16);
 }
 
 std::string CudaMemory::why_not() const {
@@ -244,8 +244,8 @@ void GlPipeline::make_buffers() {
   // force stage when there is one.
   auto node_buffer = [&](bool forces_read) {
     NodeBuffer b;
-    b.buffer = shared_ && forces_read ? shared_(bytes, NodeRole::state) : memory_->add(bytes);
-    if (n_ <= max_texels_) b.tex = make_texture_buffer(b.id(), GL_RGBA32F);  // else no pass reads it
+    b.id = shared_ && forces_read ? shared_(bytes, NodeRole::state) : memory_->add(bytes);
+    if (n_ <= max_texels_) b.tex = make_texture_buffer(b.id, GL_RGBA32F);  // else no pass reads it
     return b;
   };
   for (int k = 0; k < 2; ++k) {
@@ -259,8 +259,8 @@ void GlPipeline::make_buffers() {
     sa_[k] = node_buffer(false);
   }
   if (shared_) {
-    forces_acc_.buffer = shared_(bytes, NodeRole::accelerations);
-    if (n_ <= max_texels_) forces_acc_.tex = make_texture_buffer(forces_acc_.id(), GL_RGBA32F);
+    forces_acc_.id = shared_(bytes, NodeRole::accelerations);
+    if (n_ <= max_texels_) forces_acc_.tex = make_texture_buffer(forces_acc_.id, GL_RGBA32F);
   }
 }
 
@@ -403,7 +403,7 @@ State GlPipeline::state() {
     for (int base = 0; base < n_; base += chunk) {
       const int count = std::min(chunk, n_ - base);
       glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-      glCopyNamedBufferSubData(b.id(), staging.id(), GLintptr(base) * 16, 0, GLsizeiptr(count) * 16);
+      glCopyNamedBufferSubData(b.id, staging.id(), GLintptr(base) * 16, 0, GLsizeiptr(count) * 16);
       read_buffer(staging.id(), 0, std::size_t(count) * 16, data.data());
       for (int i = 0; i < count; ++i)
         out[std::size_t(base + i)] = {data[4 * std::size_t(i)], data[4 * std::size_t(i) + 1], data[4 * std::size_t(i) + 2]};
@@ -506,7 +506,7 @@ void GlPipeline::finish_step() {
 }
 
 std::array<GLuint, 2> GlPipeline::slot_buffers(int slot) const {
-  return slot == 0 ? std::array{x_[cur_].id(), v_[cur_].id()} : std::array{sx_[slot - 1].id(), sv_[slot - 1].id()};
+  return slot == 0 ? std::array{x_[cur_].id, v_[cur_].id} : std::array{sx_[slot - 1].id, sv_[slot - 1].id};
 }
 
 void GlPipeline::set_profiler(Profiler* p) {
@@ -619,7 +619,7 @@ void GlPipeline::reduce_displacement() {
 unsigned GlPipeline::gl_position_buffer() {
   context();
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  return x_[cur_].id();
+  return x_[cur_].id;
 }
 
 }  // namespace deformlab::gl

@@ -89,7 +89,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // For an outside force stage: the positions and velocities of state slot `slot` (GL wrote
   // them before the stage runs) and the accelerations it writes (GL reads them after).
   std::array<GLuint, 2> slot_buffers(int slot) const;
-  GLuint force_buffer() const { return forces_acc_.id(); }
+  GLuint force_buffer() const { return forces_acc_.id; }
   double max_displacement() override;
   // The state sets ping-pong: the set before the last step is kept until the next one.
   bool can_step_back() const override { return true; }
@@ -112,9 +112,8 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // the one-pass rule (one), the next stage state (stage) or the step's result (result).
   enum class PassKind { one, stage, result };
   struct NodeBuffer {
-    GLuint buffer = 0;  // owned by memory_ or by the outside force stage
-    Texture tex;        // texture buffer view (RGBA32F)
-    GLuint id() const { return buffer; }
+    GLuint id = 0;  // owned by memory_ or by the outside force stage
+    Texture tex;    // texture buffer view (RGBA32F)
   };
   // What one pass reads and writes (besides the earlier stages' slopes, bound as textures
   // for both pipelines). s0: the current state (and Verlet's previous positions); src: the

@@ -22,7 +22,7 @@ class TfPipeline final : public GlPipeline {
       glGenVertexArrays(1, &id);
       vao_[k] = VertexArray(id);
       glBindVertexArray(id);
-      const GLuint attrs[3] = {x_[k].id(), v_[k].id(), xp_[k].id()};
+      const GLuint attrs[3] = {x_[k].id, v_[k].id, xp_[k].id};
       for (GLuint a = 0; a < 3; ++a) {
         if (!attrs[a]) continue;
         glBindBuffer(GL_ARRAY_BUFFER, attrs[a]);
@@ -44,7 +44,7 @@ class TfPipeline final : public GlPipeline {
   // One transform feedback object per set of output buffers, made on first use.
   GLuint feedback(const PassIO& io) {
     std::array<GLuint, 3> key{};
-    for (int k = 0; k < io.outputs; ++k) key[k] = io.out[k]->id();
+    for (int k = 0; k < io.outputs; ++k) key[k] = io.out[k]->id;
     auto& tfo = tfos_[key];
     if (!tfo) {
       GLuint id = 0;
