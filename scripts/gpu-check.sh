@@ -135,7 +135,9 @@ fi
 if part experiments; then
   "$app" calibrate --out "$out/results/calibration.json" >"$out/calibrate.txt" 2>&1
   for x in ${EXPERIMENTS-table2 table3 tiles interop swap}; do
-    "$app" experiment "$x" --max-size "$max" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
+    sizes=(--max-size "$max")
+    grep -qs '"models"' "experiments/$x.json" && sizes=()  # a mesh sweep has models, not grid sizes
+    "$app" experiment "$x" "${sizes[@]}" --out "$out/results/$x" >"$out/experiment-$x.log" 2>&1
     summary+=("experiment $x: $(tail -2 "$out/experiment-$x.log" | head -1)")
   done
 fi
