@@ -5,7 +5,7 @@
 # go into $1 (default gpu-check/); a short table is printed last.
 # Environment: PARTS (which of "tests sanitizers bench experiments timing mesh scale endurance speed"
 # to run, default all but timing, mesh, scale, endurance and speed),
-# BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid,
+# BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid; mesh sweeps take none,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # LABELS (the tests part's ctest -L regex, default every label), SANITIZERS and MATCH_SHARDS (the
 # sanitizers part's tools and how many shards its match set runs in), ARCHIVE (see the end),
