@@ -17,7 +17,9 @@
 # together passed 10 minutes, so run them as separate commands where one is limited to that.
 # On 2c35002: tests 6.4 min (JOBS=10); sanitizers with SANITIZERS="racecheck synccheck" 6.5 (its
 # longest job racecheck on the CUDA tests, 388 s, 225 of them on CUDA-temporal's exact-match
-# test), with "memcheck initcheck" 0.8.
+# test), with "memcheck initcheck" 0.8. On 5d04c62 EXPERIMENTS=hybrid-meshes took 9.9 minutes in
+# one call, on a machine just started (its Gmsh meshes generated anew each call), and 6.2 in an
+# earlier call of the same experiment: run it alone.
 # On b1c55d7 (its bench warming each case up for a second) timing ran past 9.5 minutes: its bench
 # spent 3.6 of them on 8192^2 cuda-temporal cases, now left out, and glsl-tf's check runs 4.4 on
 # 2000 steps each, now 200: on dbe6930 it took 3.5 minutes, and the tests part (JOBS=8) 5.3.
