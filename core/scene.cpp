@@ -157,9 +157,10 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
 }
 
 // "generate": {"shape": "sheet", "size": [w, d], "cell_size": h} or {"shape": "box", "size":
-// [w, h, d], ...}; refused before meshing where it would make more than 2^30 nodes.
+// [w, h, d], ...}, optionally "threads": n; refused before meshing where it would make more
+// than 2^30 nodes.
 MeshShape shape(const json& j, const std::string& where) {
-  only_keys(j, where, {"shape", "size", "cell_size"});
+  only_keys(j, where, {"shape", "size", "cell_size", "threads"});
   for (const char* k : {"shape", "size", "cell_size"})
     if (!j.contains(k)) bad(where, std::string("needs ") + k);
   MeshShape s;
@@ -175,6 +176,10 @@ MeshShape shape(const json& j, const std::string& where) {
     s.size[sheet && k == 1 ? 2 : int(k)] = v;
   }
   s.cell_size = num(j["cell_size"], where + ".cell_size", Range::positive);
+  if (j.contains("threads")) {
+    s.threads = integer(j["threads"], where + ".threads", 1);
+    if (s.threads > 1024) bad(where + ".threads", "expected at most 1024 threads");
+  }
   if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30))
     bad(where + ".cell_size", "would make about " + std::to_string(std::int64_t(n)) + " nodes, over the limit of 2^30");
   return s;
@@ -392,7 +397,9 @@ std::string describe(const ModelSpec& m) {
     std::ostringstream os;
     os << "mesh: Gmsh " << to_string(g->kind) << " " << g->size.x << " x ";
     if (g->kind == MeshShape::Kind::box) os << g->size.y << " x ";
-    os << g->size.z << " m, cell " << g->cell_size << " m" << order;
+    os << g->size.z << " m, cell " << g->cell_size << " m";
+    if (g->threads > 0) os << ", " << g->threads << (g->threads == 1 ? " thread" : " threads");
+    os << order;
     return os.str();
   }
   return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + order;
@@ -417,6 +424,7 @@ json to_json(const Scene& s) {
       const bool sheet = g->kind == MeshShape::Kind::sheet;
       model["generate"] = {{"shape", to_string(g->kind)}, {"cell_size", g->cell_size},
                            {"size", sheet ? json::array({g->size.x, g->size.z}) : v3(g->size)}};
+      if (g->threads > 0) model["generate"]["threads"] = g->threads;
     } else {
       model.update({{"file", ms.file}, {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size}});
     }

@@ -19,6 +19,9 @@ struct MeshShape {
   enum class Kind : std::uint8_t { sheet, box } kind = Kind::sheet;
   Vec3f size{};  // m: sheet [w, 0, d] (x, z), box [w, h, d]
   float cell_size = 0.f;
+  // Gmsh's threads (0: every core). On more than one a mesh differs a little from call to call;
+  // on one a sheet is the same mesh each time (mesh/generate.cpp).
+  int threads = 0;
 };
 const char* to_string(MeshShape::Kind k);
 // The nodes Gmsh makes of a shape, estimated from its area and rim (a sheet) or volume and

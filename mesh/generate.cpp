@@ -52,13 +52,16 @@ void add_box(const MeshShape& s) {
 //   39 k at 1 M on 2 threads (42 k at 490 k on one); Delaunay (1, serial) made 5.6 k nodes/s at
 //   130 k. Gmsh 4.8 runs HXT on one thread unless Mesh.MaxNumThreads3D is set, so every
 //   stage's thread count is set here.
+// On more than one thread both make a slightly different mesh on every call (a 146 k-node sheet:
+// 146,333 to 146,388 nodes). On one a sheet is the same mesh each time; a box is not within one
+// process (Gmsh 4.8 hands HXT the boundary's nodes in the order of their addresses).
 Mesh generate_mesh(const MeshShape& s) {
   GmshSession gmsh;
   Mesh m;
   const std::string what = std::string("generating a Gmsh ") + to_string(s.kind);
   GmshSession::run(what, [&] {
     gmsh::model::add("generated");
-    const double threads = std::max(1u, std::thread::hardware_concurrency());
+    const double threads = s.threads > 0 ? unsigned(s.threads) : std::max(1u, std::thread::hardware_concurrency());
     for (const char* o : {"General.NumThreads", "Mesh.MaxNumThreads1D", "Mesh.MaxNumThreads2D", "Mesh.MaxNumThreads3D"})
       gmsh::option::setNumber(o, threads);
     gmsh::option::setNumber("Mesh.MeshSizeMin", s.cell_size);

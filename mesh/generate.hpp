@@ -6,8 +6,8 @@
 
 namespace deformlab {
 
-// The shape meshed with elements of about s.cell_size, every core meshing; throws
-// std::invalid_argument with Gmsh's message when it fails.
+// The shape meshed with elements of about s.cell_size on s.threads threads (0: every core);
+// throws std::invalid_argument with Gmsh's message when it fails.
 Mesh generate_mesh(const MeshShape& s);
 
 }  // namespace deformlab

@@ -160,6 +160,12 @@ const std::vector<BadInput>& cases() {
       scene("generate_cell_zero", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0})"),
             "s.json.model.generate.cell_size: expected a number > 0"),
       scene("generate_no_cell", G(R"({"shape": "sheet", "size": [1, 1]})"), "s.json.model.generate: needs cell_size"),
+      scene("generate_threads_zero", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1, "threads": 0})"),
+            "s.json.model.generate.threads: expected an integer >= 1"),
+      scene("generate_threads_text", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.1, "threads": "one"})"),
+            "s.json.model.generate.threads: expected an integer"),
+      scene("generate_threads_many", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.1, "threads": 4096})"),
+            "s.json.model.generate.threads: expected at most 1024 threads"),
       // about 985 M nodes: under the node limit, over any host's memory (some 950 GiB), refused before meshing
       scene("generate_over_memory", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.00085})"),
             "generated box of about 984905639 nodes: its model needs up to"),
