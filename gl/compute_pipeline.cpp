@@ -109,8 +109,9 @@ std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s, const Cu
   return std::make_unique<ComputePipeline>(s, nullptr, cuda);
 }
 
-std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared) {
-  return std::make_unique<ComputePipeline>(s, shared);
+std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared,
+                                                const CudaMemory& cuda) {
+  return std::make_unique<ComputePipeline>(s, shared, cuda);
 }
 
 }  // namespace deformlab::gl

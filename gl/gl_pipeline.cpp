@@ -224,16 +224,15 @@ std::unique_ptr<NodeMemory> CudaMemory::make_default() const {
 void GlPipeline::choose_memory(const PipelineOptions& o, const CudaMemory& cuda) {
   read_options(o);
   const auto it = o.find("memory");
-  if (it == o.end() && !shared_) {
+  if (it == o.end()) {
     memory_ = cuda.make_default();
-    chosen_["memory"] = memory_->name();
-  } else if (it != o.end() && it->second == "cuda") {
+    // The hybrids take no option memory: their interop mode places the states they share.
+    if (!shared_) chosen_["memory"] = memory_->name();
+  } else if (it->second == "cuda") {
     const std::string why = cuda.why_not();
     if (!why.empty()) throw std::invalid_argument(name_ + ": memory cuda is not available: " + why);
     memory_ = cuda.make();
   } else {
-    // memory=gl, or the hybrids' update by default: the interop mode decides where the shared
-    // states live, and the update's own buffers are GL's.
     memory_ = std::make_unique<GlBufferMemory>();
   }
 }

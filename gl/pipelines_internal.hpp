@@ -15,9 +15,11 @@ namespace deformlab::gl {
 std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s, const CudaMemory& cuda = {});
 std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s, const CudaMemory& cuda = {});
 // The same passes reading each node's acceleration from buffers allocated by `shared` and
-// written by an outside force stage (the update passes of the hybrid pipelines).
-std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared);
-std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared);
+// written by an outside force stage (the update passes of the hybrid pipelines); their own
+// buffers (Verlet's previous positions, the Runge-Kutta slopes) from `cuda` where available.
+std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared, const CudaMemory& cuda = {});
+std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared,
+                                                const CudaMemory& cuda = {});
 
 // The compute passes' dispatch: `groups` work groups as x by y, x at most `max_x` (a driver
 // may allow only the spec's 65535), y as small as possible, x * y - groups < y.

@@ -101,8 +101,8 @@ std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s, const CudaMem
   return std::make_unique<TfPipeline>(s, nullptr, cuda);
 }
 
-std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared) {
-  return std::make_unique<TfPipeline>(s, shared);
+std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared, const CudaMemory& cuda) {
+  return std::make_unique<TfPipeline>(s, shared, cuda);
 }
 
 }  // namespace deformlab::gl

@@ -56,7 +56,8 @@ class HybridPipeline final : public Pipeline, private ForceStage, private Update
     auto shared = [this](std::size_t bytes, gl::NodeRole role) {
       return sb_->add(bytes, role == gl::NodeRole::accelerations ? CudaAccess::write : CudaAccess::read);
     };
-    gl_ = o.update == Update::compute ? gl::make_compute_update(s, shared) : gl::make_tf_update(s, shared);
+    const gl::CudaMemory own = cuda_memory();  // the update's own buffers
+    gl_ = o.update == Update::compute ? gl::make_compute_update(s, shared, own) : gl::make_tf_update(s, shared, own);
   }
 
   ~HybridPipeline() override {
