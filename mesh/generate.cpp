@@ -1,6 +1,8 @@
 #include "generate.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -42,6 +44,26 @@ void add_box(const MeshShape& s) {
   gmsh::model::occ::synchronize();
 }
 
+// The current model into `path` through a partial file beside it, renamed once Gmsh is done.
+void write_model(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path to(path), partial = to.parent_path() / ("." + to.filename().string() + ".partial.msh");
+  gmsh::option::setNumber("Mesh.Binary", 1);
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  std::error_code ec;
+  try {
+    if (!to.parent_path().empty()) fs::create_directories(to.parent_path());
+    gmsh::write(partial.string());
+    fs::rename(partial, to);
+  } catch (const fs::filesystem_error& e) {
+    fs::remove(partial, ec);
+    throw std::invalid_argument("writing '" + path + "': " + e.code().message());
+  } catch (...) {
+    fs::remove(partial, ec);
+    throw;
+  }
+}
+
 }  // namespace
 
 // Algorithms, as measured on a 2-core machine (Gmsh 4.8, generate_mesh alone):
@@ -55,7 +77,7 @@ void add_box(const MeshShape& s) {
 // On more than one thread both make a slightly different mesh on every call (a 146 k-node sheet:
 // 146,333 to 146,388 nodes). On one a sheet is the same mesh each time; a box is not within one
 // process (Gmsh 4.8 hands HXT the boundary's nodes in the order of their addresses).
-Mesh generate_mesh(const MeshShape& s) {
+Mesh generate_mesh(const MeshShape& s, const std::string& save_to) {
   GmshSession gmsh;
   Mesh m;
   const std::string what = std::string("generating a Gmsh ") + to_string(s.kind);
@@ -76,6 +98,7 @@ Mesh generate_mesh(const MeshShape& s) {
     else add_box(s);
     gmsh::model::mesh::generate(sheet ? 2 : 3);
     m = read_gmsh_model(what);
+    if (!save_to.empty()) write_model(save_to);
   });
   return m;
 }

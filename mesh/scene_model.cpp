@@ -33,20 +33,11 @@ void check_memory(const Mesh& mesh) {
                std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()));
 }
 
-// The mesh the spec names: read from its file or generated (refused first when the model of
-// its estimated size would not fit: springs and elements a node as measured on Gmsh's meshes,
-// sheets 6.0 and 2.0, boxes 14.8 and 6.0, with a margin); what names it in errors.
+// The mesh the spec names: read from its file or generated; what names it in errors.
 Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
   if (ms.generate) {
     what = "generated " + std::string(to_string(ms.generate->kind));
-    const bool sheet = ms.generate->kind == MeshShape::Kind::sheet;
-    const double n = estimated_nodes(*ms.generate);
-    try {
-      check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(what + " of about " + std::to_string(std::int64_t(n)) + " nodes: " + e.what());
-    }
-    return generate_mesh(*ms.generate);
+    return generated_mesh(*ms.generate);
   }
   if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file) or a shape (model.generate)");
   what = "mesh file '" + ms.file + "'";
@@ -76,6 +67,20 @@ Model mesh_model_of(const ModelSpec& spec) {
 }
 
 }  // namespace
+
+// Refused first when the model of the estimated size would not fit: springs and elements a node
+// as measured on Gmsh's meshes, sheets 6.0 and 2.0, boxes 14.8 and 6.0, with a margin.
+Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
+  const bool sheet = shape.kind == MeshShape::Kind::sheet;
+  const double n = estimated_nodes(shape);
+  try {
+    check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("generated " + std::string(to_string(shape.kind)) + " of about " +
+                                std::to_string(std::int64_t(n)) + " nodes: " + e.what());
+  }
+  return generate_mesh(shape, save_to);
+}
 
 Model build_model_in_file_order(const Scene& s) {
   const ModelSpec& m = s.model;
