@@ -38,6 +38,11 @@ struct CalibrateArgs {
   std::optional<std::string> out;  // JSON file (default: stdout)
 };
 
+struct MeshArgs {
+  std::optional<std::string> experiment, scene, model;  // model: one of the experiment's sweep's mesh models
+  std::string out;                                       // a .msh file
+};
+
 struct ExperimentArgs {
   std::vector<std::string> argv;
   std::string file;  // a path, or the name of a built-in experiment (table1, quick, ...)
@@ -55,6 +60,7 @@ int run_command(const RunArgs& a);
 int experiment_command(const ExperimentArgs& a);
 int list_command();
 int calibrate_command(const CalibrateArgs& a);
+int mesh_command(const MeshArgs& a);
 int view_command(const ViewArgs& a);
 
 // This device's calibration (interop/calibrate.hpp) with the build, machine and `argv`;

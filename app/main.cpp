@@ -93,6 +93,13 @@ int main(int argc, char** argv) {
       "calibrate", "Measure this device's ceilings (copy, transform feedback, compute, interop hand-offs) as JSON");
   calibrate->add_option("--out,-o", cal.out, "JSON file to write (default: standard output)");
 
+  deformlab::app::MeshArgs mesh_args;
+  auto* mesh = cli.add_subcommand("mesh", "Write the mesh a scene generates (its model's \"generate\") to a Gmsh .msh file");
+  mesh->add_option("--experiment", mesh_args.experiment, "Experiment file or built-in name (default: paper-drag)");
+  mesh->add_option("--scene", mesh_args.scene, "Scene file overriding the experiment's scene");
+  mesh->add_option("--model", mesh_args.model, "One of the mesh models the experiment's sweep names");
+  mesh->add_option("--out,-o", mesh_args.out, "The .msh file to write")->required();
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -108,5 +115,6 @@ int main(int argc, char** argv) {
   if (*list) return deformlab::app::list_command();
   if (*calibrate) return deformlab::app::calibrate_command(cal);
   if (*view) return deformlab::app::view_command(v);
+  if (*mesh) return deformlab::app::mesh_command(mesh_args);
   return 2;
 }

@@ -1,6 +1,7 @@
 // The deformlab command end to end: the outputs of a run and what a failed run leaves
 // (bad inputs: bad_input_test.cpp).
 #include <nlohmann/json.hpp>
+#include <regex>
 
 #include "cli_support.hpp"
 
@@ -42,6 +43,30 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_TRUE(m["build"].contains("compiler"));
   EXPECT_TRUE(m["machine"].contains("hardware_threads"));
   EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
+}
+
+// `deformlab mesh` writes the mesh an experiment's model generates; a scene naming that file in
+// place of "generate" runs on it, with the nodes the command counted.
+TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
+  write("x.json", R"({"scene": {"model": {"type": "mesh", "pins": "none", "generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 1}}},
+      "sweep": {"models": [{"name": "small", "model": {"generate": {"shape": "sheet", "size": [0.2, 0.1], "cell_size": 0.02}}}],
+                "pipelines": ["cpu"]}})");
+  const fs::path file = dir_ / "meshes" / "small.msh";
+  const Result made = run("mesh --experiment " + (dir_ / "x.json").string() + " --model small --out " + file.string());
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("Gmsh sheet 0.2 x 0.1 m, cell 0.02 m"), std::string::npos) << made.out;
+  std::smatch count;
+  ASSERT_TRUE(std::regex_search(made.out, count, std::regex("\n  ([0-9]+) nodes, "))) << made.out;
+  const std::string nodes = count[1];
+  EXPECT_GT(std::stoi(nodes), 50) << made.out;
+  EXPECT_NE(made.out.find("triangles, made and written in"), std::string::npos) << made.out;
+  ASSERT_TRUE(fs::is_regular_file(file));
+
+  write("s.json", R"({"model": {"type": "mesh", "pins": "none", "file": "meshes/small.msh"}})");
+  const Result r = run("run --pipeline cpu --steps 3 --no-state --scene " + (dir_ / "s.json").string() + " --out " +
+                       (dir_ / "run").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(": " + nodes + " nodes, "), std::string::npos) << r.out;
 }
 
 // A run on a GPU pipeline says at what clock the GPU ran its steps (NVML, where the NVIDIA driver

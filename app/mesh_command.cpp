@@ -1,0 +1,63 @@
+// `deformlab mesh`: the mesh a scene generates with Gmsh, written to a .msh file that a scene
+// can name in place of its "generate", so that runs share one mesh.
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <stdexcept>
+
+#include "commands.hpp"
+#include "experiments/sweep_models.hpp"
+#include "mesh/scene_model.hpp"
+
+namespace deformlab::app {
+namespace {
+
+// The experiment's scene, with --scene and, for a sweep of mesh models, the --model named.
+Scene chosen_scene(const MeshArgs& a) {
+  Experiment x = a.experiment ? load_experiment_by_name(*a.experiment) : default_experiment();
+  if (a.scene) x.scene = load_scene(*a.scene);
+  const auto sweep = parse_sweep(x.raw, x.name);
+  std::string names;
+  for (const auto& m : sweep ? sweep->models : std::vector<SweepModel>{}) {
+    if (a.model && m.name == *a.model) return model_cell_scene(x, *sweep, Cell{.model = m.name});
+    names += (names.empty() ? "" : ", ") + m.name;
+  }
+  const std::string whose = "experiment '" + x.name + "'";
+  if (!a.model) {
+    if (!x.scene.model.mesh.generate && !names.empty())
+      throw std::invalid_argument(whose + " sweeps mesh models: name one with --model (" + names + ")");
+    return x.scene;
+  }
+  if (names.empty()) throw std::invalid_argument("--model '" + *a.model + "': " + whose + " sweeps no mesh models");
+  throw std::invalid_argument("--model '" + *a.model + "': " + whose + " has no such model (its models: " + names + ")");
+}
+
+}  // namespace
+
+int mesh_command(const MeshArgs& a) {
+  return report_errors([&] {
+    namespace fs = std::filesystem;
+    if (fs::path(a.out).extension() != ".msh")
+      throw std::invalid_argument("--out '" + a.out + "': expected a file name ending in .msh");
+    if (fs::is_directory(a.out)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
+    const Scene scene = chosen_scene(a);
+    const auto& g = scene.model.mesh.generate;
+    if (scene.model.topology != Topology::general || !g)
+      throw std::invalid_argument("the scene's model (" + describe(scene.model) +
+                                  ") is not generated: only a model's \"generate\" makes a mesh to write");
+    const auto t0 = std::chrono::steady_clock::now();
+    const Mesh m = generated_mesh(*g, a.out);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::string shape = describe(scene.model);  // "mesh: Gmsh box ... m, cell ... m, order ..."
+    shape = shape.substr(6, shape.rfind(", order ") - 6);
+    std::cout << std::setprecision(3) << "deformlab mesh: " << shape << "\n  " << m.position.size() << " nodes, "
+              << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
+              << (m.volume() ? " tetrahedra" : " triangles") << ", made and written in " << s << " s (host clock)\n"
+              << "  wrote " << a.out << " (binary MSH 4.1, before the model's scale and transform): name it as the "
+              << "model's \"file\" in place of \"generate\" and every run reads this mesh\n";
+    return 0;
+  });
+}
+
+}  // namespace deformlab::app
