@@ -200,8 +200,10 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   // last one waits for the queued steps; cuda-temporal's launches) says in how many.
   const int sampled = profiler.sampled_count(r.steps);
   for (const auto& g : profiler.summary()) {
+    // A GPU pipeline's check is the host waiting for the device's work, then reading its result.
+    const bool waits = on_gpu(*in.entry) && g.name == span::reductions;
     std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
-              << " ms  (" << g.clock;
+              << " ms  (" << g.clock << (waits ? ", waiting for the device" : "");
     if (g.steps < sampled) std::cout << "; in " << g.steps << (g.steps == 1 ? " step" : " steps");
     std::cout << ")\n";
   }

@@ -48,7 +48,8 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
 // `deformlab mesh` writes the mesh an experiment's model generates; a scene naming that file in
 // place of "generate" runs on it, with the nodes the command counted.
 TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
-  write("x.json", R"({"scene": {"model": {"type": "mesh", "pins": "none", "generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 1}}},
+  write("x.json", R"({"scene": {"model": {"type": "mesh", "pins": "none",
+                                         "generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 1}}},
       "sweep": {"models": [{"name": "small", "model": {"generate": {"shape": "sheet", "size": [0.2, 0.1], "cell_size": 0.02}}}],
                 "pipelines": ["cpu"]}})");
   const fs::path file = dir_ / "meshes" / "small.msh";
@@ -77,6 +78,8 @@ TEST_F(Cli, GpuRunSaysTheClockItsStepsRanAt) {
                        out.string());
   if (r.err.find("is not available") != std::string::npos) GTEST_SKIP() << r.err;
   ASSERT_EQ(r.code, 0) << r.err;
+  // Its checks' time is the host's, waiting for the device (a CPU run's: below).
+  EXPECT_NE(r.out.find(" ms  (host clock, waiting for the device)\n"), std::string::npos) << r.out;
   const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
   const nlohmann::json& clock = m["result"]["sm_clock"];
   if (clock.is_null()) {
