@@ -165,17 +165,20 @@ JSON
     --tiles 16x8 --temporal-sizes 2048 --steps-per-launch 2 --csv "$out/timing-bench-cuda.csv" \
     >"$out/timing-bench-cuda.txt" 2>&1
   "$bench" gl --sizes 2048 --integrator explicit-euler --csv "$out/timing-bench-gl.csv" >"$out/timing-bench-gl.txt" 2>&1
-  "$bench" hybrid --sizes 2048 --integrator explicit-euler --modes map --no-baselines \
+  "$bench" hybrid --sizes 2048 --integrator explicit-euler --modes map external-gpusync --no-baselines \
     --csv "$out/timing-bench-hybrid.csv" >"$out/timing-bench-hybrid.txt" 2>&1
   # The bench's row of each: cuda [steps] (exact) and [fused] (paper scene, fast); gl by name;
-  # hybrid's in map mode (exact: the bench's hybrids take the pipelines' defaults).
+  # the hybrids' in the interop mode their run chose (exact: the bench's hybrids take the
+  # pipelines' defaults).
   bench_ms() {
     case $1/$2 in
       cuda-fused/exact | cuda-naive/exact) awk -F, -v v="${1#cuda-}" '$1 == "steps" && $5 == v { print $11 " @" $15 }' "$out/timing-bench-cuda.csv" ;;
       cuda-fused/fast) awk -F, '$1 == "fused" && $2 == "paper" && $6 == "explicit-euler" && $8 == "fast" { print $11 " @" $15 }' "$out/timing-bench-cuda.csv" ;;
       glsl-compute/exact | glsl-tf/exact) awk -F, -v w="$1" '$4 == w { print $5 " @" $8 }' "$out/timing-bench-gl.csv" ;;
       glsl-compute/fast) awk -F, '$4 == "glsl-compute-fast" { print $5 " @" $8 }' "$out/timing-bench-gl.csv" ;;
-      hybrid/exact | hybrid-compute/exact) awk -F, -v p="$1" '$2 == p && $3 == "map" { print $6 " @" $12 }' "$out/timing-bench-hybrid.csv" ;;
+      hybrid/exact | hybrid-compute/exact)
+        mode=$(grep -o '"interop": *"[a-z-]*"' "$out/timing-run-$1-$2.json" | head -1 | sed 's/.*"\([a-z-]*\)"$/\1/')
+        awk -F, -v p="$1" -v m="$mode" '$2 == p && $3 == m { print $6 " @" $12 }' "$out/timing-bench-hybrid.csv" ;;
       *) echo - ;;
     esac
   }
