@@ -62,6 +62,13 @@ TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   EXPECT_GT(std::stoi(nodes), 50) << made.out;
   EXPECT_NE(made.out.find("triangles, made and written in"), std::string::npos) << made.out;
   ASSERT_TRUE(fs::is_regular_file(file));
+  // A folder by that name is refused, as it stands.
+  fs::create_directories(dir_ / "folder.msh");
+  const Result folder = run("mesh --experiment " + (dir_ / "x.json").string() + " --model small --out " +
+                            (dir_ / "folder.msh").string());
+  EXPECT_EQ(folder.code, 2);
+  EXPECT_NE(folder.err.find("folder.msh' is a folder"), std::string::npos) << folder.err;
+  EXPECT_TRUE(fs::is_empty(dir_ / "folder.msh"));
 
   write("s.json", R"({"model": {"type": "mesh", "pins": "none", "file": "meshes/small.msh"}})");
   const Result r = run("run --pipeline cpu --steps 3 --no-state --scene " + (dir_ / "s.json").string() + " --out " +
