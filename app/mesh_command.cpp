@@ -49,9 +49,7 @@ int mesh_command(const MeshArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const Mesh m = generated_mesh(*g, a.out);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::string shape = describe(scene.model);  // "mesh: Gmsh box ... m, cell ... m, order ..."
-    shape = shape.substr(6, shape.rfind(", order ") - 6);
-    std::cout << std::setprecision(3) << "deformlab mesh: " << shape << "\n  " << m.position.size() << " nodes, "
+    std::cout << std::setprecision(3) << "deformlab mesh: " << describe(*g) << "\n  " << m.position.size() << " nodes, "
               << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
               << (m.volume() ? " tetrahedra" : " triangles") << ", made and written in " << s << " s (host clock)\n"
               << "  wrote " << a.out << " (binary MSH 4.1, before the model's scale and transform): name it as the "

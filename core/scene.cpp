@@ -385,6 +385,15 @@ double estimated_nodes(const MeshShape& s) {
   return kBoxPerVolume * x * y * z / (h * h * h) + kBoxPerSurface * 2 * (x * y + y * z + z * x) / (h * h);
 }
 
+std::string describe(const MeshShape& g) {
+  std::ostringstream os;
+  os << "Gmsh " << to_string(g.kind) << " " << g.size.x << " x ";
+  if (g.kind == MeshShape::Kind::box) os << g.size.y << " x ";
+  os << g.size.z << " m, cell " << g.cell_size << " m";
+  if (g.threads > 0) os << ", " << g.threads << (g.threads == 1 ? " thread" : " threads");
+  return os.str();
+}
+
 std::string describe(const ModelSpec& m) {
   switch (m.topology) {
     case Topology::cloth_grid: return "cloth " + std::to_string(m.nx) + "x" + std::to_string(m.ny);
@@ -393,15 +402,7 @@ std::string describe(const ModelSpec& m) {
     case Topology::general: break;
   }
   const std::string order = ", order " + std::string(to_string(m.mesh.order));
-  if (const auto& g = m.mesh.generate) {
-    std::ostringstream os;
-    os << "mesh: Gmsh " << to_string(g->kind) << " " << g->size.x << " x ";
-    if (g->kind == MeshShape::Kind::box) os << g->size.y << " x ";
-    os << g->size.z << " m, cell " << g->cell_size << " m";
-    if (g->threads > 0) os << ", " << g->threads << (g->threads == 1 ? " thread" : " threads");
-    os << order;
-    return os.str();
-  }
+  if (m.mesh.generate) return "mesh: " + describe(*m.mesh.generate) + order;
   return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + order;
 }
 
