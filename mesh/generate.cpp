@@ -47,7 +47,10 @@ void add_box(const MeshShape& s) {
 // The current model into `path` through a partial file beside it, renamed once Gmsh is done.
 void write_model(const std::string& path) {
   namespace fs = std::filesystem;
-  const fs::path to(path), partial = to.parent_path() / ("." + to.filename().string() + ".partial.msh");
+  const fs::path to(path);
+  std::string name = to.filename().string();
+  name.insert(0, 1, '.');
+  const fs::path partial = to.parent_path() / (name += ".partial.msh");
   gmsh::option::setNumber("Mesh.Binary", 1);
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
   std::error_code ec;
