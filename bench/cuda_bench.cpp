@@ -36,10 +36,8 @@ cuda::Variant parse_variant(const std::string& s) {
   throw std::invalid_argument("unknown CUDA variant '" + s + "' (naive, tiled, scatter, fused, temporal)");
 }
 
-// cuda-fused's default block in math m on the bench's cloths, "WxH".
-std::string fused_block(Math m) {
-  return cuda::to_string(cuda::default_tile(cuda::Variant::fused, m, Topology::cloth_grid));
-}
+// cuda-fused's default block on the bench's cloths, "WxH".
+std::string fused_block() { return cuda::to_string(cuda::default_tile(cuda::Variant::fused, Topology::cloth_grid)); }
 
 struct Row {
   std::string table, scene, grid, variant, integrator, tile, math;
@@ -86,12 +84,12 @@ class Report {
 
   // The bare gather (cuda::time_bare_gather) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
-  // node) or Verlet (80), on cuda-fused's block in fast math.
+  // node) or Verlet (80), on cuda-fused's block.
   Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
     const Model& m = scene.model;
     const bool damped = m.damped();
     const int n = m.nx;
-    const cuda::Tile tile = cuda::default_tile(cuda::Variant::fused, Math::fast, m.topology);
+    const cuda::Tile tile = cuda::default_tile(cuda::Variant::fused, m.topology);
     Row r;
     r.table = "bare-gather";
     r.scene = to_string(kind);
@@ -209,7 +207,7 @@ void run_cuda(const CudaOptions& o) {
 
   if (o.tile_size > 0) {
     std::cout << "\n[bare gather] cuda-fused's loads and stores at " << o.tile_size << "^2 without its arithmetic "
-              << "(block " << fused_block(Math::fast) << ", cuda-fused's in fast math): "
+              << "(block " << fused_block() << ", cuda-fused's): "
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each timed as the steps are (after "
@@ -231,8 +229,8 @@ void run_cuda(const CudaOptions& o) {
 
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
               << "ceiling, the bare gather and the paper author's CUDA Verlet cloth kernel (" << o.reference_ms
-              << " ms per step at 2048^2 on this machine type), on cuda-fused's default blocks ("
-              << fused_block(Math::exact) << " exact, " << fused_block(Math::fast) << " fast)\n"
+              << " ms per step at 2048^2 on this machine type), on cuda-fused's default block ("
+              << fused_block() << ")\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(7) << "math" << std::setw(12)
               << "ms/step" << std::setw(10) << "B/node" << std::setw(10) << "of copy" << std::setw(10) << "of bare"
               << std::setw(14) << "vs reference" << "\n";

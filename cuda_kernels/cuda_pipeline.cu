@@ -9,6 +9,7 @@
 #include <thrust/transform_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -27,6 +28,7 @@
 #include "core/step_params.hpp"
 #include "kernels.cuh"
 #include "temporal.cuh"
+#include "tma_tile.cuh"
 #include "math_builds.hpp"
 
 namespace deformlab::cuda::DL_CUDA_MATH {
@@ -102,6 +104,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
     if (temporal_ && sched_.rule == UpdateRule::verlet)
       for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
+    tma_ = dev::kTmaCloth && fused_ && m.topology == Topology::cloth_grid && o_.tile.x == dev::kTmaW &&
+           o_.tile.y == dev::kTmaH && device_info().cc_major >= 9;
+    for (int c = 0; tma_ && c < sets_; ++c)
+      tma_maps_[c] = {cloth_tensor_map(x_[c].get(), m.nx, m.ny), cloth_tensor_map(v_[c].get(), m.nx, m.ny)};
     stop_.allocate(sets_ + 1, "allocating the stop rule's reduction");
     check(cudaMemsetAsync(stop_.get(), 0, (sets_ + 1) * sizeof(unsigned), stream_),
           "clearing the stop rule's reduction");
@@ -447,6 +453,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       kernel<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp, has_prev_, xo, vo,
                                                      tg, stop_check());
       check_launch("launching the fused CSR step kernel");
+    } else if (tma_) {
+      const auto kernel = damped_ ? dev::fused_cloth_tma<true, Rule> : dev::fused_cloth_tma<false, Rule>;
+      kernel<<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, tma_maps_[cur_][0], tma_maps_[cur_][1], v,
+                                                            xp, has_prev_, xo, vo, tg, stop_check());
+      check_launch("launching the fused cloth step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
@@ -627,6 +638,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   cudaGraphExec_t graph_[3] = {};  // one step from each state set
   int cur_ = 0;
   int prefetch_ = 0;  // fused grid launches with dev::kPrefetchAhead: plan_prefetch
+  bool tma_ = false;  // fused cloth launches by dev::fused_cloth_tma, each set's (x, v) through its tensor maps
+  std::array<CUtensorMap, 2> tma_maps_[3] = {};
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back

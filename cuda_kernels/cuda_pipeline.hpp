@@ -76,12 +76,13 @@ class CudaPipeline : public Pipeline {
 // The registry's options (tile, steps_per_launch, math) as variant v reads them; throws
 // std::invalid_argument on a bad value.
 Options options_of(Variant v, const PipelineOptions& o);
-// Variant v's tile in math m on a model of topology t when none is chosen: 16 x 8, except for
-// cuda-fused: 32 x 8 in fast math on cloths (H100, paper scene, explicit Euler, one call: 0.1056
+// Variant v's tile on a model of topology t when none is chosen: 16 x 8, except for
+// cuda-fused: 32 x 8 on cloths (H100, paper scene, explicit Euler, one call, fast math: 0.1056
 // against 0.1076 ms at 2048^2 and 1.540 against 1.633 at 8192^2; exact math within 1% across
-// shapes) and 16 x 16 on lattices (semi-implicit Euler on six lattices from 96^3 to 48x48x1536:
-// 2-5% faster in exact math, up to 3% in fast math, never more than 0.6% slower; docs/speed.md).
-Tile default_tile(Variant v, Math m, Topology t);
+// shapes, and on 32 x 8 it takes the tensor memory accelerator's copies: tma_tile.cuh) and 16 x 16
+// on lattices (semi-implicit Euler on six lattices from 96^3 to 48x48x1536: 2-5% faster in exact
+// math, up to 3% in fast math, never more than 0.6% slower; docs/speed.md).
+Tile default_tile(Variant v, Topology t);
 // The tile the pipeline of options o runs model m on: o.tile, else default_tile.
 Tile tile_for(const Options& o, const Model& m);
 

@@ -39,13 +39,13 @@ Tile tile_option(const PipelineOptions& o) {
   return it == o.end() ? Tile{} : parse_tile(it->second);
 }
 
-Tile default_tile(Variant v, Math m, Topology t) {
+Tile default_tile(Variant v, Topology t) {
   if (v == Variant::fused && t == Topology::lattice) return {16, 16};
-  return v == Variant::fused && m == Math::fast && t == Topology::cloth_grid ? Tile{32, 8} : Tile{16, 8};
+  return v == Variant::fused && t == Topology::cloth_grid ? Tile{32, 8} : Tile{16, 8};
 }
 
 Tile tile_for(const Options& o, const Model& m) {
-  return o.tile.x > 0 ? o.tile : default_tile(o.variant, o.math, m.topology);
+  return o.tile.x > 0 ? o.tile : default_tile(o.variant, m.topology);
 }
 
 TemporalTile parse_temporal_tile(const std::string& s) {

@@ -254,7 +254,7 @@ TEST(CudaPipeline, TileShapeAndMathArePipelineOptions) {
   EXPECT_THROW(cuda::tile_option({{"tile", "0x4"}}), std::invalid_argument);
 }
 
-TEST(CudaPipeline, FusedDefaultBlocksFollowMathAndTopology) {
+TEST(CudaPipeline, FusedDefaultBlocksFollowTopology) {
   using cuda::Variant;
   const Model cloth = small_cloth(8, 8), lattice = small_lattice(4, 4, 4);
   auto tile = [](Variant v, const PipelineOptions& o, const Model& m) {
@@ -263,7 +263,7 @@ TEST(CudaPipeline, FusedDefaultBlocksFollowMathAndTopology) {
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, cloth), "32x8");
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}}, lattice), "16x16");
   EXPECT_EQ(tile(Variant::fused, {}, lattice), "16x16");
-  EXPECT_EQ(tile(Variant::fused, {}, cloth), "16x8");
+  EXPECT_EQ(tile(Variant::fused, {}, cloth), "32x8");
   EXPECT_EQ(tile(Variant::naive, {}, lattice), "16x8");
   EXPECT_EQ(tile(Variant::naive, {{"math", "fast"}}, cloth), "16x8");
   EXPECT_EQ(tile(Variant::tiled, {{"math", "fast"}}, cloth), "16x8");
