@@ -1,5 +1,5 @@
-// `deformlab mesh`: the mesh a scene generates with Gmsh, written to a .msh file that a scene
-// can name in place of its "generate", so that runs share one mesh.
+// `deformlab mesh`: the mesh a scene generates or fills with Gmsh, written to a .msh file that a
+// scene can name as its model's "file", so that runs share one mesh.
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -13,6 +13,11 @@
 namespace deformlab::app {
 namespace {
 
+// Whether Gmsh makes the model's mesh: a shape it generates or a surface it fills.
+bool makes_mesh(const ModelSpec& m) {
+  return m.topology == Topology::general && (m.mesh.generate || m.mesh.fill);
+}
+
 // The experiment's scene, with --scene and, for a sweep of mesh models, the --model named.
 Scene chosen_scene(const MeshArgs& a) {
   Experiment x = a.experiment ? load_experiment_by_name(*a.experiment) : default_experiment();
@@ -25,7 +30,7 @@ Scene chosen_scene(const MeshArgs& a) {
   }
   const std::string whose = "experiment '" + x.name + "'";
   if (!a.model) {
-    if (!x.scene.model.mesh.generate && !names.empty())
+    if (!names.empty())
       throw std::invalid_argument(whose + " sweeps mesh models: name one with --model (" + names + ")");
     return x.scene;
   }
@@ -42,18 +47,22 @@ int mesh_command(const MeshArgs& a) {
       throw std::invalid_argument("--out '" + a.out + "': expected a file name ending in .msh");
     if (fs::is_directory(a.out)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
     const Scene scene = chosen_scene(a);
-    const auto& g = scene.model.mesh.generate;
-    if (scene.model.topology != Topology::general || !g)
-      throw std::invalid_argument("the scene's model (" + describe(scene.model) +
-                                  ") is not generated: only a model's \"generate\" makes a mesh to write");
+    const MeshSpec& ms = scene.model.mesh;
+    if (!makes_mesh(scene.model))
+      throw std::invalid_argument("the scene's model (" + describe(scene.model) + ") is neither generated nor filled: " +
+                                  "only a model's \"generate\" or \"fill\" makes a mesh to write");
     const auto t0 = std::chrono::steady_clock::now();
-    const Mesh m = generated_mesh(*g, a.out);
+    const Mesh m = ms.generate ? generated_mesh(*ms.generate, a.out) : filled_mesh(ms, a.out);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::cout << std::setprecision(3) << "deformlab mesh: " << describe(*g) << "\n  " << m.position.size() << " nodes, "
-              << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
+    std::cout << std::setprecision(3) << "deformlab mesh: " << (ms.generate ? describe(*ms.generate) : describe(scene.model))
+              << "\n  " << m.position.size() << " nodes, " << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
               << (m.volume() ? " tetrahedra" : " triangles") << ", made and written in " << s << " s (host clock)\n"
-              << "  wrote " << a.out << " (binary MSH 4.1, before the model's scale and transform): name it as the "
-              << "model's \"file\" in place of \"generate\" and every run reads this mesh\n";
+              << "  wrote " << a.out << " (binary MSH 4.1, "
+              << (ms.generate ? "before the model's scale and transform): name it as the model's \"file\" in place of "
+                                "\"generate\""
+                              : "after the model's scale and transform): name it as the model's \"file\" without "
+                                "\"fill\", \"scale\" and \"transform\"")
+              << " and every run reads this mesh\n";
     return 0;
   });
 }

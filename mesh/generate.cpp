@@ -1,7 +1,6 @@
 #include "generate.hpp"
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -44,29 +43,6 @@ void add_box(const MeshShape& s) {
   gmsh::model::occ::synchronize();
 }
 
-// The current model into `path` through a partial file beside it, renamed once Gmsh is done.
-void write_model(const std::string& path) {
-  namespace fs = std::filesystem;
-  const fs::path to(path);
-  std::string name = to.filename().string();
-  name.insert(0, 1, '.');
-  const fs::path partial = to.parent_path() / (name += ".partial.msh");
-  gmsh::option::setNumber("Mesh.Binary", 1);
-  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
-  std::error_code ec;
-  try {
-    if (!to.parent_path().empty()) fs::create_directories(to.parent_path());
-    gmsh::write(partial.string());
-    fs::rename(partial, to);
-  } catch (const fs::filesystem_error& e) {
-    fs::remove(partial, ec);
-    throw std::invalid_argument("writing '" + path + "': " + e.code().message());
-  } catch (...) {
-    fs::remove(partial, ec);
-    throw;
-  }
-}
-
 }  // namespace
 
 // Algorithms, as measured on a 2-core machine (Gmsh 4.8, generate_mesh alone):
@@ -101,7 +77,7 @@ Mesh generate_mesh(const MeshShape& s, const std::string& save_to) {
     else add_box(s);
     gmsh::model::mesh::generate(sheet ? 2 : 3);
     m = read_gmsh_model(what);
-    if (!save_to.empty()) write_model(save_to);
+    if (!save_to.empty()) write_gmsh_model(save_to);
   });
   return m;
 }

@@ -10,8 +10,7 @@ namespace deformlab {
 
 // The shape meshed with elements of about s.cell_size on s.threads threads (0: every core);
 // throws std::invalid_argument with Gmsh's message when it fails. With `save_to`, Gmsh also
-// writes the mesh there as binary MSH 4.1 (replacing the file only once it is whole), which
-// load_mesh reads back as the same mesh: nodes, their order and the elements.
+// writes the mesh there (write_gmsh_model).
 Mesh generate_mesh(const MeshShape& s, const std::string& save_to = {});
 
 }  // namespace deformlab

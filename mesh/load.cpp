@@ -58,6 +58,28 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
 
 }  // namespace
 
+void write_gmsh_model(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path to(path);
+  std::string name = to.filename().string();
+  name.insert(0, 1, '.');
+  const fs::path partial = to.parent_path() / (name += ".partial.msh");
+  gmsh::option::setNumber("Mesh.Binary", 1);
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  std::error_code ec;
+  try {
+    if (!to.parent_path().empty()) fs::create_directories(to.parent_path());
+    gmsh::write(partial.string());
+    fs::rename(partial, to);
+  } catch (const fs::filesystem_error& e) {
+    fs::remove(partial, ec);
+    throw std::invalid_argument("writing '" + path + "': " + e.code().message());
+  } catch (...) {
+    fs::remove(partial, ec);
+    throw;
+  }
+}
+
 Mesh read_gmsh_model(const std::string& what) {
   std::vector<std::size_t> tags;
   std::vector<double> coord, param;
@@ -118,7 +140,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   return m;
 }
 
-Mesh fill_tetrahedra(const Mesh& surface, float cell_size) {
+Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to) {
   GmshSession gmsh;
   Mesh m;
   GmshSession::run("filling the surface with tetrahedra", [&] {
@@ -141,6 +163,7 @@ Mesh fill_tetrahedra(const Mesh& surface, float cell_size) {
     gmsh::model::mesh::generate(3);
     m = read_gmsh_model("filling the surface with tetrahedra");
     if (!m.volume()) throw std::invalid_argument("Gmsh made no tetrahedra (is the surface closed?)");
+    if (!save_to.empty()) write_gmsh_model(save_to);
   });
   return m;
 }

@@ -17,8 +17,9 @@ namespace deformlab {
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 
 // The closed surface filled with tetrahedra (Gmsh, its nodes kept); cell_size > 0 caps the
-// tetrahedra's edges. Throws std::invalid_argument when Gmsh cannot fill it.
-Mesh fill_tetrahedra(const Mesh& surface, float cell_size);
+// tetrahedra's edges. With `save_to`, Gmsh also writes the filled mesh there (write_gmsh_model).
+// Throws std::invalid_argument when Gmsh cannot fill it.
+Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to = {});
 
 // The library versions, for manifests.
 std::string mesh_library_versions();

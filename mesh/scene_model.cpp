@@ -44,26 +44,44 @@ Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>
   return load_mesh(ms.file, notes);
 }
 
-Model mesh_model_of(const ModelSpec& spec) {
-  const MeshSpec& ms = spec.mesh;
-  std::vector<std::string> notes;
-  std::string what;
-  Mesh mesh = source_mesh(ms, what, notes);
-  place(mesh, ms);
+// f(), with `what` before the message of its std::invalid_argument.
+template <class F>
+auto naming(const std::string& what, F&& f) {
   try {
-    for (auto& line : repair(mesh)) notes.push_back(std::move(line));
-    if (ms.fill) {
-      if (mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
-      mesh = fill_tetrahedra(mesh, ms.cell_size);
-      for (auto& line : repair(mesh)) notes.push_back("after filling: " + line);
-    }
-    check_memory(mesh);
-    Model m = mesh_model(mesh, spec.material, ms.density);
-    m.repairs = std::move(notes);
-    return m;
+    return f();
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(what + ": " + e.what());
   }
+}
+
+// The mesh a spec's model is made of: read or generated, placed by its scale and transform,
+// repaired and, with "fill", filled with tetrahedra (the filled mesh also written to `fill_to`
+// when given); `what` names it in errors.
+Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string& what,
+                const std::string& fill_to = {}) {
+  Mesh mesh = source_mesh(ms, what, notes);
+  place(mesh, ms);
+  return naming(what, [&] {
+    for (auto& line : repair(mesh)) notes.push_back(std::move(line));
+    if (ms.fill) {
+      if (mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
+      mesh = fill_tetrahedra(mesh, ms.cell_size, fill_to);
+      for (auto& line : repair(mesh)) notes.push_back("after filling: " + line);
+    }
+    return std::move(mesh);
+  });
+}
+
+Model mesh_model_of(const ModelSpec& spec) {
+  std::vector<std::string> notes;
+  std::string what;
+  const Mesh mesh = model_mesh(spec.mesh, notes, what);
+  return naming(what, [&] {
+    check_memory(mesh);
+    Model m = mesh_model(mesh, spec.material, spec.mesh.density);
+    m.repairs = std::move(notes);
+    return m;
+  });
 }
 
 }  // namespace
@@ -80,6 +98,13 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
                                 std::to_string(std::int64_t(n)) + " nodes: " + e.what());
   }
   return generate_mesh(shape, save_to);
+}
+
+Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to) {
+  if (!ms.fill) throw std::logic_error("filled_mesh of a model without \"fill\"");
+  std::vector<std::string> notes;
+  std::string what;
+  return model_mesh(ms, notes, what, save_to);
 }
 
 Model build_model_in_file_order(const Scene& s) {

@@ -17,6 +17,12 @@ Model build_model(const Scene& s);
 // (generate_mesh).
 Mesh generated_mesh(const MeshShape& shape, const std::string& save_to = {});
 
+// The mesh of a model with "fill" as Gmsh fills it: the surface read or generated, placed by
+// the model's scale and transform, repaired, filled; also written to `save_to`
+// (write_gmsh_model). A model naming that file, without "fill", "scale" and "transform", is
+// built from the same mesh.
+Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
+
 // build_model in two parts, for callers that keep one mesh in several orders: the model with
 // its pins in the file's order (a generated mesh: Gmsh's), then the scene's node order.
 Model build_model_in_file_order(const Scene& s);

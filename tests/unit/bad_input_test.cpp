@@ -180,9 +180,9 @@ const std::vector<BadInput>& cases() {
       // `deformlab mesh`: the file it would write is checked first, then the scene or model
       {"mesh_out_not_msh", "mesh --scene {dir}/s.json --out {dir}/m.obj", "m.obj': expected a file name ending in .msh",
        {{"s.json", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1})")}}},
-      {"mesh_not_generated", "mesh --scene {dir}/s.json --out {dir}/m.msh", ") is not generated: only a model's \"generate\"",
+      {"mesh_not_generated", "mesh --scene {dir}/s.json --out {dir}/m.msh", ") is neither generated nor filled: only a model's \"generate\" or \"fill\"",
        {{"s.json", "{\"model\": {\"type\": \"mesh\", \"file\": \"m.obj\", \"pins\": \"none\"}}"}}},
-      {"mesh_grid", "mesh --out {dir}/m.msh", "the scene's model (cloth 128x128) is not generated"},
+      {"mesh_grid", "mesh --out {dir}/m.msh", "the scene's model (cloth 128x128) is neither generated nor filled"},
       {"mesh_model_unknown", "mesh --experiment meshes --model box-9m --out {dir}/m.msh",
        "--model 'box-9m': experiment 'meshes' has no such model (its models: bunny-shell, bunny-soft, sheet-1m"},
       {"mesh_model_missing", "mesh --experiment meshes --out {dir}/m.msh",

@@ -45,6 +45,17 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
 }
 
+// The node count deformlab mesh prints at the start of its second line ("  N nodes, "), or -1.
+int mesh_nodes(const std::string& out) {
+  const std::size_t second_line = out.find("\n  ");
+  if (second_line == std::string::npos) return -1;
+  std::istringstream counts(out.substr(second_line + 3));
+  int nodes = -1;
+  std::string unit;
+  counts >> nodes >> unit;
+  return unit == "nodes," ? nodes : -1;
+}
+
 // `deformlab mesh` writes the mesh an experiment's model generates; a scene naming that file in
 // place of "generate" runs on it, with the nodes the command counted.
 TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
@@ -56,13 +67,7 @@ TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   const Result made = run("mesh --experiment " + (dir_ / "x.json").string() + " --model small --out " + file.string());
   ASSERT_EQ(made.code, 0) << made.err;
   EXPECT_NE(made.out.find("Gmsh sheet 0.2 x 0.1 m, cell 0.02 m"), std::string::npos) << made.out;
-  const std::size_t second_line = made.out.find("\n  ");
-  ASSERT_NE(second_line, std::string::npos) << made.out;
-  std::istringstream counts(made.out.substr(second_line + 3));
-  int node_count = 0;
-  std::string unit;
-  counts >> node_count >> unit;
-  EXPECT_EQ(unit, "nodes,") << made.out;
+  const int node_count = mesh_nodes(made.out);
   EXPECT_GT(node_count, 50) << made.out;
   const std::string nodes = std::to_string(node_count);
   EXPECT_NE(made.out.find("triangles, made and written in"), std::string::npos) << made.out;
@@ -80,6 +85,24 @@ TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
                        (dir_ / "run").string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find(": " + nodes + " nodes, "), std::string::npos) << r.out;
+}
+
+// A filled surface (the bunny-soft scene's) written out: a scene naming the file without "fill",
+// "scale" and "transform" runs on the nodes the command counted.
+TEST_F(Cli, MeshWritesAFilledMeshThatARunReads) {
+  const fs::path file = dir_ / "soft.msh";
+  const Result made = run("mesh --scene " DEFORMLAB_SOURCE_DIR "/data/bunny/bunny-soft.json --out " + file.string());
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("bunny.obj filled with tetrahedra"), std::string::npos) << made.out;
+  EXPECT_NE(made.out.find("after the model's scale and transform"), std::string::npos) << made.out;
+  const int node_count = mesh_nodes(made.out);
+  EXPECT_GT(node_count, 1839) << made.out;  // the surface's nodes and the interior's
+  EXPECT_NE(made.out.find("tetrahedra, made and written in"), std::string::npos) << made.out;
+  write("s.json", R"({"model": {"type": "mesh", "pins": "none", "file": "soft.msh"}})");
+  const Result r = run("run --pipeline cpu --steps 3 --no-state --scene " + (dir_ / "s.json").string() + " --out " +
+                       (dir_ / "run").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(": " + std::to_string(node_count) + " nodes, "), std::string::npos) << r.out;
 }
 
 // A run on a GPU pipeline says at what clock the GPU ran its steps (NVML, where the NVIDIA driver

@@ -154,6 +154,33 @@ TEST_F(MeshFile, TheBunnyIsClosedAndFillsWithTetrahedra) {
   EXPECT_NEAR(filled, std::abs(enclosed), 1e-4 * std::abs(enclosed));
 }
 
+// deformlab mesh's filled meshes: a surface filled with tetrahedra and written out reads back
+// as the same mesh, and a model naming that file without "fill", "scale" and "transform" is
+// built from it node for node.
+TEST_F(MeshFile, AFilledMeshWrittenOutBuildsTheSameModel) {
+  Scene filling;
+  apply_json(filling, nlohmann::json::parse(R"({"model": {"type": "mesh", "file": ")" DEFORMLAB_SOURCE_DIR
+                                            R"(/data/bunny/bunny.obj", "scale": 0.02,
+      "transform": {"translate": [0.03, 0.3, 0]}, "fill": "tetrahedra", "density": 1000, "pins": "none"}})"),
+             "s", dir_.string());
+  const fs::path file = dir_ / "meshes" / "soft.msh";
+  const Mesh filled = filled_mesh(filling.model.mesh, file.string());
+  ASSERT_TRUE(filled.volume());
+  EXPECT_GT(filled.position.size(), 1839u) << "the surface's nodes and the interior's";
+  const Mesh read = load(file.string());
+  EXPECT_EQ(read.position, filled.position);
+  EXPECT_EQ(read.tetrahedron, filled.tetrahedron);
+  EXPECT_FALSE(fs::exists(dir_ / "meshes" / ".soft.msh.partial.msh"));
+
+  Scene reading;
+  apply_json(reading, nlohmann::json::parse(R"({"model": {"type": "mesh", "file": "meshes/soft.msh", "density": 1000,
+      "pins": "none"}})"), "s", dir_.string());
+  const Model m = build_model(reading);
+  ASSERT_EQ(m.node_count(), int(filled.position.size()));
+  for (int v = 0; v < m.node_count(); ++v) ASSERT_EQ(m.rest_position[v], filled.position[v]) << v;
+  EXPECT_THROW(filled_mesh(reading.model.mesh, (dir_ / "x.msh").string()), std::logic_error);
+}
+
 // One scene in two node orders: the pins and the drag node are the same nodes, and the
 // trajectories agree node by node in the file's order.
 TEST_F(MeshFile, NodeOrderChangesNothingButSpeed) {
