@@ -42,12 +42,13 @@ Stats time_pipeline(Pipeline& p, const Model& m, const StepOptions& o) {
   return s;
 }
 
-// The memory glsl-compute's node buffers take when no memory option is given.
+// The memory glsl-compute's node buffers take when no memory option is given (a build without
+// interop has no CUDA memory to offer: GL's buffers).
 std::unique_ptr<gl::NodeMemory> default_memory() {
 #if DEFORMLAB_HAVE_INTEROP
   return interop::cuda_memory().make_default();
 #else
-  return std::make_unique<gl::GlBufferMemory>();
+  return gl::CudaMemory{}.make_default();
 #endif
 }
 
