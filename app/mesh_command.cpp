@@ -49,20 +49,22 @@ int mesh_command(const MeshArgs& a) {
     const Scene scene = chosen_scene(a);
     const MeshSpec& ms = scene.model.mesh;
     if (!makes_mesh(scene.model))
-      throw std::invalid_argument("the scene's model (" + describe(scene.model) + ") is neither generated nor filled: " +
-                                  "only a model's \"generate\" or \"fill\" makes a mesh to write");
+      throw std::invalid_argument("the scene's model (" + describe(scene.model) +
+                                  ") is neither generated nor filled: only a model's \"generate\" or \"fill\" "
+                                  "makes a mesh to write");
     const auto t0 = std::chrono::steady_clock::now();
     const Mesh m = ms.generate ? generated_mesh(*ms.generate, a.out) : filled_mesh(ms, a.out);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::cout << std::setprecision(3) << "deformlab mesh: " << (ms.generate ? describe(*ms.generate) : describe(scene.model))
-              << "\n  " << m.position.size() << " nodes, " << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
+    const char* naming = ms.generate ? "before the model's scale and transform): name it as the model's \"file\" in "
+                                       "place of \"generate\""
+                                     : "after the model's scale and transform): name it as the model's \"file\" with "
+                                       "no fill, scale or transform (\"fill\": \"none\", \"scale\": 1, "
+                                       "\"transform\": {} where the scene sets them)";
+    std::cout << std::setprecision(3) << "deformlab mesh: "
+              << (ms.generate ? describe(*ms.generate) : describe(scene.model)) << "\n  " << m.position.size()
+              << " nodes, " << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
               << (m.volume() ? " tetrahedra" : " triangles") << ", made and written in " << s << " s (host clock)\n"
-              << "  wrote " << a.out << " (binary MSH 4.1, "
-              << (ms.generate ? "before the model's scale and transform): name it as the model's \"file\" in place of "
-                                "\"generate\""
-                              : "after the model's scale and transform): name it as the model's \"file\" without "
-                                "\"fill\", \"scale\" and \"transform\"")
-              << " and every run reads this mesh\n";
+              << "  wrote " << a.out << " (binary MSH 4.1, " << naming << " and every run reads this mesh\n";
     return 0;
   });
 }

@@ -84,7 +84,7 @@ class Report {
 
   // The bare gather (cuda::time_bare_gather) of the scene's springs (their neighbours' velocities
   // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
-  // node) or Verlet (80), on cuda-fused's block.
+  // node) or Verlet (80), on cuda-fused's block, with its per-thread loads of fast math.
   Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
     const Model& m = scene.model;
     const bool damped = m.damped();
@@ -206,8 +206,9 @@ void run_cuda(const CudaOptions& o) {
   }
 
   if (o.tile_size > 0) {
-    std::cout << "\n[bare gather] cuda-fused's loads and stores at " << o.tile_size << "^2 without its arithmetic "
-              << "(block " << fused_block() << ", cuda-fused's): "
+    std::cout << "\n[bare gather] fast-math cuda-fused's loads and stores at " << o.tile_size
+              << "^2 without its arithmetic (block " << fused_block() << ", cuda-fused's; in exact math it loads "
+              << "cloths through the tensor memory accelerator instead): "
               << "each node's x and v and its 12 "
               << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each timed as the steps are (after "

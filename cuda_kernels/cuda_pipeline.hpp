@@ -30,7 +30,7 @@ const char* to_string(Variant v);
 
 // Thread-block shape over a grid's (i, j) plane for the gather kernels (one node per
 // thread); cuda-tiled stages the block's nodes plus a 2-node halo in shared memory.
-// 0 x 0: none chosen, the variant's default for the model and math (tile_for).
+// 0 x 0: none chosen, the variant's default for the model (tile_for).
 struct Tile {
   int x = 0, y = 0;
 };

@@ -1,9 +1,10 @@
 // cuda-fused's cloth step with each block's nodes and their halo copied into shared memory by
 // the tensor memory accelerator (TMA, compute capability 9.0 and up): one cp.async.bulk.tensor
 // a state array and block, issued by one thread, instead of a load a neighbour and thread. It
-// runs in exact math on 32 x 8 blocks, where it measured 2-6% faster than dev::fused_grid; in
-// fast math it was 24-30% slower (H200, paper scene; docs/speed.md), so fast math keeps
-// fused_grid. Same arithmetic in the same order: the same bits.
+// runs in exact math on 32 x 8 blocks, where it measured 2.0-5.9% faster than dev::fused_grid on
+// the 16 x 8 blocks exact math ran before; in fast math it was 24-30% slower than fused_grid
+// (H200, paper scene; docs/speed.md), so fast math keeps fused_grid. Same arithmetic in the
+// same order: the same bits.
 #pragma once
 #include <cuda.h>
 #include <cudaTypedefs.h>
@@ -15,10 +16,12 @@
 namespace deformlab::cuda::DL_CUDA_MATH::dev {
 
 constexpr int kTmaW = 32, kTmaH = 8;  // the block's nodes
-#ifdef DL_CUDA_FAST_MATH
-constexpr bool kTmaCloth = false;
-#else
+// Whether cuda-fused runs it (on a device of compute capability 9.0 or more): the exact build,
+// where every architecture built for has the accelerator (cuda_kernels/CMakeLists.txt).
+#ifdef DL_CUDA_TMA
 constexpr bool kTmaCloth = true;
+#else
+constexpr bool kTmaCloth = false;
 #endif
 constexpr int kTmaBoxW = kTmaW + 2 * kHalo, kTmaBoxH = kTmaH + 2 * kHalo;
 
@@ -35,8 +38,9 @@ __device__ __forceinline__ void copy_box(const CUtensorMap& map, void* to, int i
 #endif
 }
 
-// Reads (x, v) through the tensor maps tx, tv and x_prev (Verlet), writes (xo, vo): fused_grid
-// on a cloth, its neighbours from the block's box in shared memory.
+// Reads x through the tensor map tx, v through tv where springs are damped (else from v) and
+// x_prev (Verlet), writes (xo, vo): fused_grid on a cloth, its neighbours from the block's box
+// in shared memory.
 template <bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters)
     fused_cloth_tma(StepParams s, Stencil st, float weight, const __grid_constant__ CUtensorMap tx,

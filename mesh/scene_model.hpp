@@ -17,10 +17,10 @@ Model build_model(const Scene& s);
 // (generate_mesh).
 Mesh generated_mesh(const MeshShape& shape, const std::string& save_to = {});
 
-// The mesh of a model with "fill" as Gmsh fills it: the surface read or generated, placed by
+// The mesh of a model with "fill" as Gmsh fills it: the surface read from its file, placed by
 // the model's scale and transform, repaired, filled; also written to `save_to`
-// (write_gmsh_model). A model naming that file, without "fill", "scale" and "transform", is
-// built from the same mesh.
+// (write_gmsh_model). A model naming that file, with no fill, scale or transform, is built from
+// the same mesh.
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
 
 // build_model in two parts, for callers that keep one mesh in several orders: the model with
