@@ -224,6 +224,17 @@ __device__ __forceinline__ Window load_tile(const StepParams& s, const float4* _
   return {sh, Damped ? sh + cells : nullptr, base, tw, tw * th};
 }
 
+// Grid node (i, j, k)'s acceleration, its neighbours read through w; pinned and hard-dragged
+// nodes skip the gather.
+template <int N, bool Damped>
+__device__ __forceinline__ Vec3f grid_accel(const StepParams& s, const Stencil& st, int i, int j, int k, int node,
+                                            const float4& x4, const float4& v4, const Window& w,
+                                            const Vec3f& drag_target) {
+  if (P::node_fixed(s, node, x4.w)) return {};
+  const Vec3f xi = xyz(x4), vi = xyz(v4);
+  return P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), drag_target);
+}
+
 // Force pass on a grid: acc = a(x, v). Tiled: neighbours from a shared tile.
 template <int N, bool Damped, bool Tiled>
 __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil st, const float4* __restrict__ x,
@@ -236,13 +247,7 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
   if (i >= s.nx || j >= s.ny) return;
   const int node = P::grid_node(i, j, k, s.nx, s.ny);
   if constexpr (!Tiled) w.base = node;
-  const float4 x4 = x[node], v4 = v[node];
-  Vec3f a{};
-  if (!P::node_fixed(s, node, x4.w)) {
-    const Vec3f xi = xyz(x4), vi = xyz(v4);
-    a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), drag_target);
-  }
-  acc[node] = f4(a, 0.f);
+  acc[node] = f4(grid_accel<N, Damped>(s, st, i, j, k, node, x[node], v[node], w, drag_target), 0.f);
 }
 
 // Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v) and
@@ -266,12 +271,7 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil s
       asm volatile("prefetch.global.L2 [%0];" ::"l"(v + node + prefetch));
     }
     const float4 x4 = x[node], v4 = v[node];
-    Vec3f a{};
-    if (!P::node_fixed(s, node, x4.w)) {
-      const Vec3f xi = xyz(x4), vi = xyz(v4);
-      const Window w{x, v, node, s.nx, s.nx * s.ny};
-      a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), tg.force);
-    }
+    const Vec3f a = grid_accel<N, Damped>(s, st, i, j, k, node, x4, v4, {x, v, node, s.nx, s.nx * s.ny}, tg.force);
     d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
   }
   store_displacement(check, d);

@@ -124,12 +124,8 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
       const int node = P::grid_node(i, j, k, s.nx, s.ny);
       const float4 x4 = sx(cur)[l], v4 = sv(cur)[l];
       const Vec3f xi = xyz(x4), vi = xyz(v4);
-      Vec3f acc{};
-      if (!P::node_fixed(s, node, x4.w)) {
-        const Window w{sx(cur), sv(cur), l, r.cells.x, r.cells.x * r.cells.y};
-        acc = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w),
-                                   tg.step[q].force);
-      }
+      const Window w{sx(cur), sv(cur), l, r.cells.x, r.cells.x * r.cells.y};
+      const Vec3f acc = grid_accel<N, Damped>(s, st, i, j, k, node, x4, v4, w, tg.step[q].force);
       const Vec3f xp = kVerlet && prev ? xyz(sx(1 - cur)[l]) : Vec3f{};
       Vec3f xn, vn;
       P::one_pass_update(Rule, weight, xi, vi, acc, xp, prev, s.dt, xn, vn);

@@ -70,12 +70,7 @@ __global__ void __maxnreg__(kGatherRegisters)
   if (i < s.nx && j < s.ny) {
     const int node = j * s.nx + i, at = (threadIdx.y + kHalo) * kTmaBoxW + threadIdx.x + kHalo;
     const float4 x4 = box[0][at], v4 = Damped ? box[1][at] : v[node];
-    Vec3f a{};
-    if (!P::node_fixed(s, node, x4.w)) {
-      const Vec3f xi = xyz(x4), vi = xyz(v4);
-      const Window w{box[0], box[1], at, kTmaBoxW, 0};
-      a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<12, Damped>(s, st, i, j, 0, xi, vi, w), tg.force);
-    }
+    const Vec3f a = grid_accel<12, Damped>(s, st, i, j, 0, node, x4, v4, {box[0], box[1], at, kTmaBoxW, 0}, tg.force);
     d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
   }
   store_displacement(check, d);
