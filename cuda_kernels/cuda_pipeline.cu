@@ -13,7 +13,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <memory>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -104,10 +106,14 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
     if (temporal_ && sched_.rule == UpdateRule::verlet)
       for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
-    tma_ = dev::kTmaCloth && fused_ && m.topology == Topology::cloth_grid && o_.tile.x == dev::kTmaW &&
-           o_.tile.y == dev::kTmaH && device_info().cc_major >= 9;
-    for (int c = 0; tma_ && c < sets_; ++c)
-      tma_maps_[c] = {cloth_tensor_map(x_[c].get(), m.nx, m.ny), cloth_tensor_map(v_[c].get(), m.nx, m.ny)};
+    if (tma_misfit(o_, m, su.integrator).empty()) {
+      tma_ = device_info().cc_major >= 9 && o_.tma.value_or(o_.math == Math::exact);
+      if (!o_.tma && o_.math == Math::exact) chosen_["tma"] = tma_ ? "on" : "off";
+    }
+    for (int c = 0; tma_ && c < sets_; ++c) {
+      tma_maps_[c][0] = cloth_tensor_map(x_[c].get(), m.nx, m.ny);
+      if (damped_) tma_maps_[c][1] = cloth_tensor_map(v_[c].get(), m.nx, m.ny);
+    }
     stop_.allocate(sets_ + 1, "allocating the stop rule's reduction");
     check(cudaMemsetAsync(stop_.get(), 0, (sets_ + 1) * sizeof(unsigned), stream_),
           "clearing the stop rule's reduction");
@@ -258,6 +264,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
         throw std::runtime_error("the launch after a step did not pass its largest displacement on");
     }
   }
+
+  std::map<std::string, std::string> chosen_options() const override { return chosen_; }
 
   Energy energy() override {
     flush();
@@ -413,6 +421,12 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     if (o.variant == Variant::temporal && !su.model.grid())
       throw std::invalid_argument("cuda-temporal runs grid models (cloths and lattices), not meshes (use cuda-fused)");
     if (o.variant == Variant::tiled || su.model.topology != Topology::general) check_tile(su.model, o.tile);
+    if (o.tma.value_or(false)) {
+      std::string why = tma_misfit(o, su.model, su.integrator);
+      if (why.empty() && device_info().cc_major < 9) why = "the device's compute capability is below 9.0";
+      if (!why.empty())
+        throw std::invalid_argument("option tma=on: the tensor memory accelerator's kernel cannot run: " + why);
+    }
     require_device_memory(bytes_needed(su.model.size(), su.integrator, o),
                           std::string("the cuda-") + to_string(o.variant) + " pipeline for " +
                               std::to_string(su.model.node_count()) + " nodes (" +
@@ -638,8 +652,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   cudaGraphExec_t graph_[3] = {};  // one step from each state set
   int cur_ = 0;
   int prefetch_ = 0;  // fused grid launches with dev::kPrefetchAhead: plan_prefetch
-  bool tma_ = false;  // fused cloth launches by dev::fused_cloth_tma, each set's (x, v) through its tensor maps
+  // Fused cloth launches by dev::fused_cloth_tma, each set's x (and v if damped) through its tensor maps.
+  bool tma_ = false;
   std::array<CUtensorMap, 2> tma_maps_[3] = {};
+  std::map<std::string, std::string> chosen_;  // chosen_options
   bool has_prev_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back

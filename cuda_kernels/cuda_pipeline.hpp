@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/energy.hpp"
@@ -61,6 +62,9 @@ struct Options {
   Math math = Math::exact;  // the kernels' arithmetic (the build of cuda_pipeline.cu that runs)
   int steps_per_launch = 0;  // cuda-temporal: steps per launch (k); 0: the default
   TemporalTile temporal_tile;
+  // cuda-fused on cloths: the blocks' nodes through the tensor memory accelerator (option tma);
+  // none given: in exact math where the device has it (cuda_kernels/tma_tile.cuh).
+  std::optional<bool> tma;
 };
 
 class CudaPipeline : public Pipeline {
@@ -73,7 +77,7 @@ class CudaPipeline : public Pipeline {
   std::string timing_method() const override { return "CUDA events"; }
 };
 
-// The registry's options (tile, steps_per_launch, math) as variant v reads them; throws
+// The registry's options (tile, steps_per_launch, tma, math) as variant v reads them; throws
 // std::invalid_argument on a bad value.
 Options options_of(Variant v, const PipelineOptions& o);
 // Variant v's tile on a model of topology t when none is chosen: 16 x 8, except for

@@ -108,6 +108,11 @@ Options options_of(Variant v, const PipelineOptions& o) {
   Options out{v, {}, true, math_option(o)};
   if (v != Variant::temporal) {
     out.tile = tile_option(o);
+    if (const auto it = o.find("tma"); v == Variant::fused && it != o.end()) {
+      if (it->second != "on" && it->second != "off")
+        throw std::invalid_argument("option tma '" + it->second + "' is not on or off");
+      out.tma = it->second == "on";
+    }
     return out;
   }
   out.steps_per_launch = steps_per_launch_option(o);
@@ -188,10 +193,11 @@ void add_cuda_pipelines(PipelineRegistry& r) {
     const PipelineTraits traits{Engine::cuda, Engine::cuda, gather, gather ? CpuMatch::bitwise : CpuMatch::rounding,
                                 v == Variant::temporal};
     // "tile": the thread block shape WxH of the grid kernels (default 16x8); on cuda-temporal
-    // the nodes a block writes, with "steps_per_launch".
+    // the nodes a block writes, with "steps_per_launch"; "tma" (on|off) on cuda-fused.
     std::vector<std::string> options;
     if (gather) options.push_back("tile");
     if (v == Variant::temporal) options.push_back("steps_per_launch");
+    if (v == Variant::fused) options.push_back("tma");
     options.push_back("math");
     r.add({e.name, e.summary, traits, [] { return cuda::unavailable(); },
            [v](Integrator i) { return cuda::unsupported(i, v); },

@@ -1,27 +1,29 @@
 // cuda-fused's cloth step with each block's nodes and their halo copied into shared memory by
 // the tensor memory accelerator (TMA, compute capability 9.0 and up): one cp.async.bulk.tensor
 // a state array and block, issued by one thread, instead of a load a neighbour and thread. It
-// runs in exact math on 32 x 8 blocks, where it measured 2.0-5.9% faster than dev::fused_grid on
-// the 16 x 8 blocks exact math ran before; in fast math it was 24-30% slower than fused_grid
-// (H200, paper scene; docs/speed.md), so fast math keeps fused_grid. Same arithmetic in the
-// same order: the same bits.
+// runs on 32 x 8 blocks, by default in exact math, where it measured 2.0-5.9% faster than
+// dev::fused_grid on the 16 x 8 blocks exact math ran before; in fast math it was 24-30% slower
+// than fused_grid (H200, paper scene; docs/speed.md), so fast math takes it only when the
+// pipeline option tma=on asks. Same arithmetic in the same order as fused_grid: the same bits.
 #pragma once
 #include <cuda.h>
 #include <cudaTypedefs.h>
 
 #include <stdexcept>
+#include <string>
 
+#include "cuda_pipeline.hpp"
 #include "kernels.cuh"
 
 namespace deformlab::cuda::DL_CUDA_MATH::dev {
 
 constexpr int kTmaW = 32, kTmaH = 8;  // the block's nodes
-// Whether cuda-fused runs it (on a device of compute capability 9.0 or more): the exact build,
-// where every architecture built for has the accelerator (cuda_kernels/CMakeLists.txt).
+// Whether cuda-fused can run it (on a device of compute capability 9.0 or more): builds whose
+// every architecture has the accelerator (cuda_kernels/CMakeLists.txt).
 #ifdef DL_CUDA_TMA
-constexpr bool kTmaCloth = true;
+constexpr bool kTmaBuilt = true;
 #else
-constexpr bool kTmaCloth = false;
+constexpr bool kTmaBuilt = false;
 #endif
 constexpr int kTmaBoxW = kTmaW + 2 * kHalo, kTmaBoxH = kTmaH + 2 * kHalo;
 
@@ -80,6 +82,17 @@ __global__ void __maxnreg__(kGatherRegisters)
 }  // namespace deformlab::cuda::DL_CUDA_MATH::dev
 
 namespace deformlab::cuda::DL_CUDA_MATH {
+
+// Why dev::fused_cloth_tma cannot take the steps of `integrator` on model m with options o (o.tile
+// set), whatever the device; empty where it can, on a device of compute capability 9.0 or more.
+inline std::string tma_misfit(const Options& o, const Model& m, Integrator integrator) {
+  if (!dev::kTmaBuilt) return "this build includes CUDA architectures below 90";
+  if (o.variant != Variant::fused || !make_schedule(integrator).single_pass())
+    return "it takes cuda-fused's one-kernel steps (explicit-euler, semi-implicit-euler, verlet)";
+  if (m.topology != Topology::cloth_grid) return "it runs grid cloths";
+  if (o.tile.x != dev::kTmaW || o.tile.y != dev::kTmaH) return "it runs blocks of 32x8 nodes";
+  return {};
+}
 
 // A tensor map over a cloth's nx x ny float4 array (dimensions: the 4 floats, i, j) in boxes
 // of the block and its halo, for dev::fused_cloth_tma. The driver's encoder is reached through

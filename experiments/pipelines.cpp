@@ -37,7 +37,8 @@ constexpr PipelineTraits hybrid(Engine update) { return {Engine::cuda, update, t
 // In order of expected speed on a GPU machine (cuda-temporal, faster on grids, follows
 // cuda-fused, which runs every model); the CPU pipelines close the list.
 const Known kKnown[] = {
-    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
+    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise),
+     {"tile", "tma", "math"}},
     {"cuda-temporal", "CUDA, k fused steps per launch on shared-memory tiles (grids)", "CUDA",
      {Engine::cuda, Engine::cuda, true, CpuMatch::bitwise, true}, {"tile", "steps_per_launch", "math"}},
     {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},

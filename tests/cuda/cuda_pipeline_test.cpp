@@ -239,16 +239,21 @@ TEST(CudaPipeline, WithoutADeviceMakingAPipelineFailsWithTheReason) {
   }
 }
 
-TEST(CudaPipeline, TileShapeAndMathArePipelineOptions) {
+TEST(CudaPipeline, TileShapeTmaAndMathArePipelineOptions) {
   PipelineRegistry r;
   add_cuda_pipelines(r);
-  for (const char* n : {"cuda-naive", "cuda-tiled", "cuda-fused"})
+  for (const char* n : {"cuda-naive", "cuda-tiled"})
     EXPECT_EQ(r.find(n)->options, (std::vector<std::string>{"tile", "math"})) << n;
+  EXPECT_EQ(r.find("cuda-fused")->options, (std::vector<std::string>{"tile", "tma", "math"}));
   EXPECT_EQ(r.find("cuda-scatter")->options, std::vector<std::string>{"math"});
   EXPECT_EQ(r.find("cuda-temporal")->options, (std::vector<std::string>{"tile", "steps_per_launch", "math"}));
   EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {{"math", "fast"}}).math, Math::fast);
   EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {}).math, Math::exact);
   EXPECT_THROW(cuda::options_of(cuda::Variant::fused, {{"math", "fastest"}}), std::invalid_argument);
+  EXPECT_FALSE(cuda::options_of(cuda::Variant::fused, {}).tma.has_value());
+  EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {{"tma", "on"}}).tma, true);
+  EXPECT_EQ(cuda::options_of(cuda::Variant::fused, {{"tma", "off"}}).tma, false);
+  EXPECT_THROW(cuda::options_of(cuda::Variant::fused, {{"tma", "yes"}}), std::invalid_argument);
   EXPECT_EQ(cuda::tile_option({{"tile", "32x4"}}).x, 32);
   EXPECT_EQ(cuda::tile_option({}).x, cuda::Tile{}.x);
   EXPECT_THROW(cuda::tile_option({{"tile", "0x4"}}), std::invalid_argument);
@@ -268,6 +273,39 @@ TEST(CudaPipeline, FusedDefaultBlocksFollowTopology) {
   EXPECT_EQ(tile(Variant::naive, {{"math", "fast"}}, cloth), "16x8");
   EXPECT_EQ(tile(Variant::tiled, {{"math", "fast"}}, cloth), "16x8");
   EXPECT_EQ(tile(Variant::fused, {{"math", "fast"}, {"tile", "16x8"}}, cloth), "16x8");  // the option wins
+}
+
+// cuda-fused's cloth kernel through the tensor memory accelerator: taken by default in exact
+// math on 32x8 blocks where the device has the accelerator (the run records the choice), on
+// request in fast math; tma=on where it cannot run is refused with the reason. Its bits are
+// fused_grid's: the match tests run both against cpu.
+TEST(CudaPipeline, FusedClothsTakeTheTmaWhereItRuns) {
+  DEFORMLAB_REQUIRE_CUDA();
+  const Model cloth = make_model(kShapes[2]), lattice = make_model(kShapes[5]);
+  auto make = [&](const Model& m, Integrator i, const PipelineOptions& o) {
+    return cuda::make_pipeline({m, scene_params(), i}, cuda::options_of(Variant::fused, o));
+  };
+  auto refusal = [&](const Model& m, Integrator i, const PipelineOptions& o) -> std::string {
+    try {
+      make(m, i, o);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "(not refused)";
+  };
+  const bool has_tma = cuda::device_info().cc_major >= 9;
+  using Chosen = std::map<std::string, std::string>;
+  EXPECT_EQ(make(cloth, Integrator::verlet, {})->chosen_options(), (Chosen{{"tma", has_tma ? "on" : "off"}}));
+  // Nothing chosen by the machine where the option is given or exact math's default cannot take it.
+  for (const PipelineOptions& o : {PipelineOptions{{"math", "fast"}}, {{"tma", "off"}}, {{"tile", "16x8"}}})
+    EXPECT_TRUE(make(cloth, Integrator::verlet, o)->chosen_options().empty());
+  EXPECT_TRUE(make(lattice, Integrator::verlet, {})->chosen_options().empty());
+  EXPECT_TRUE(make(cloth, Integrator::rk4, {})->chosen_options().empty());
+  if (has_tma) EXPECT_TRUE(make(cloth, Integrator::verlet, {{"tma", "on"}, {"math", "fast"}})->chosen_options().empty());
+  else EXPECT_NE(refusal(cloth, Integrator::verlet, {{"tma", "on"}}).find("compute capability"), std::string::npos);
+  EXPECT_NE(refusal(cloth, Integrator::verlet, {{"tma", "on"}, {"tile", "16x8"}}).find("32x8"), std::string::npos);
+  EXPECT_NE(refusal(lattice, Integrator::verlet, {{"tma", "on"}}).find("grid cloths"), std::string::npos);
+  EXPECT_NE(refusal(cloth, Integrator::rk4, {{"tma", "on"}}).find("one-kernel steps"), std::string::npos);
 }
 
 TEST(CudaPipeline, ParsesTileShapes) {

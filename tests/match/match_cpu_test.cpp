@@ -53,15 +53,18 @@ const Shape kShapes[] = {
 };
 
 // Option values tried beyond the defaults, by option name (PipelineEntry::options), the
-// shapes (kShapes) they are tried on and the integrators (by default one and several force
-// passes).
+// shapes (kShapes) they are tried on, the integrators (by default one and several force
+// passes) and other options set with them.
 struct OptionValues {
   const char* option;
   std::vector<std::string> values;
   std::vector<int> shapes;
   std::vector<Integrator> integrators = {Integrator::semi_implicit_euler, Integrator::rk4};
+  PipelineOptions with = {};
 };
-// The one-pass rules of the fused kernels (each its own update code) and a multi-pass one.
+// The one-pass rules of the fused kernels (each its own update code), and a multi-pass one.
+const std::vector<Integrator> kOnePass = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
+                                          Integrator::verlet};
 const std::vector<Integrator> kOnePassAndRk4 = {Integrator::explicit_euler, Integrator::semi_implicit_euler,
                                                 Integrator::verlet, Integrator::rk4};
 const OptionValues kOptionValues[] = {
@@ -72,6 +75,10 @@ const OptionValues kOptionValues[] = {
     // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
     {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},
     {"math", {"fast"}, {0, 6, 7, 9}, kOnePassAndRk4},  // exact is the default: every case above runs it
+    // cuda-fused's cloths: exact math's default kernel (the TMA copy, on a device of compute
+    // capability 9.0 or more) left out, and taken in fast math
+    {"tma", {"off"}, {0, 1, 6}, kOnePass},
+    {"tma", {"on"}, {0, 1, 6}, kOnePass, {{"math", "fast"}}},
     // GL's own buffers: the default where CUDA's memory can be imported (every case above there)
     {"memory", {"gl"}, {0, 6, 8}},
 };
@@ -181,12 +188,15 @@ std::vector<Case> cases() {
       for (int s = 0; s < int(std::size(kShapes)); ++s)
         if (runs(e, s)) out.push_back({e.name, i.id, s});
     }
-    for (const auto& [option, values, shapes, integs] : kOptionValues) {
+    for (const auto& [option, values, shapes, integs, with] : kOptionValues) {
       if (std::find(e.options.begin(), e.options.end(), option) == e.options.end()) continue;
       for (const std::string& v : values)
         for (Integrator i : integs)
-          for (int s : shapes)
-            if (runs(e, s) && e.unsupported(i).empty()) out.push_back({e.name, i, s, {{option, v}}});
+          for (int s : shapes) {
+            PipelineOptions o = with;
+            o[option] = v;
+            if (runs(e, s) && e.unsupported(i).empty()) out.push_back({e.name, i, s, o});
+          }
     }
   }
   return out;
