@@ -83,7 +83,7 @@ if part sanitizers && [ -x "$cuda_tests" ] && command -v compute-sanitizer >/dev
     shards=${MATCH_SHARDS:-4}
     for ((i = 0; i < shards; ++i)); do
       GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i compute-sanitizer --tool "$tool" "$match_tests" \
-        --gtest_filter='*/cuda_*cloth37x53*:*/cuda_fused_*cloth32:*/cuda_fused_*cloth32_math_fast:*/cuda_fused_*contact37x53_math_fast:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*' \
+        --gtest_filter='*/cuda_*cloth37x53*:*/cuda_fused_*cloth32:*/cuda_fused_*cloth32_math_fast:*/cuda_fused_*_tma_*:*/cuda_fused_*contact37x53_math_fast:*/cuda_*lattice6x5x4*:*/cuda_*surface30x20*:*/cuda_*volume8x6x5*:*LiveChanges*/cuda_*:*StepBack*/cuda_*' \
         >"$out/sanitizer-$tool-match-$i.log" 2>&1 &
     done
   done
