@@ -45,7 +45,7 @@ void add_box(const MeshShape& s) {
 
 }  // namespace
 
-// Algorithms, as measured on a 2-core machine (Gmsh 4.8, generate_mesh alone):
+// Algorithms, as measured on a 2-core machine (Gmsh 4.8, generate_shape alone):
 // - sheets: 2D Delaunay (Mesh.Algorithm 5) over tiles: 62 k nodes/s at 50 k nodes, 70 k at
 //   200 k, 83 k at 1 M; Frontal-Delaunay (6) made 22 k nodes/s at 330 k (and 12% fewer nodes
 //   per area). Gmsh meshes the tiles on its 2D threads.
@@ -56,7 +56,7 @@ void add_box(const MeshShape& s) {
 // On more than one thread both make a slightly different mesh on every call (a 146 k-node sheet:
 // 146,333 to 146,388 nodes). On one a sheet is the same mesh each time; a box is not within one
 // process (Gmsh 4.8 hands HXT the boundary's nodes in the order of their addresses).
-Mesh generate_mesh(const MeshShape& s, const std::string& save_to) {
+Mesh generate_shape(const MeshShape& s, const std::string& save_to) {
   GmshSession gmsh;
   Mesh m;
   const std::string what = std::string("generating a Gmsh ") + to_string(s.kind);

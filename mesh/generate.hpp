@@ -11,6 +11,6 @@ namespace deformlab {
 // The shape meshed with elements of about s.cell_size on s.threads threads (0: every core);
 // throws std::invalid_argument with Gmsh's message when it fails. With `save_to`, Gmsh also
 // writes the mesh there (write_gmsh_model).
-Mesh generate_mesh(const MeshShape& s, const std::string& save_to = {});
+Mesh generate_shape(const MeshShape& s, const std::string& save_to = {});
 
 }  // namespace deformlab

@@ -97,7 +97,7 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
     throw std::invalid_argument("generated " + std::string(to_string(shape.kind)) + " of about " +
                                 std::to_string(std::int64_t(n)) + " nodes: " + e.what());
   }
-  return generate_mesh(shape, save_to);
+  return generate_shape(shape, save_to);
 }
 
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to) {

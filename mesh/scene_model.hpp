@@ -14,7 +14,7 @@ Model build_model(const Scene& s);
 
 // The mesh of a scene's "generate" as Gmsh makes it (before its scale and transform), refused
 // when its model would not fit in host memory; also written to `save_to` when given
-// (generate_mesh).
+// (generate_shape).
 Mesh generated_mesh(const MeshShape& shape, const std::string& save_to = {});
 
 // The mesh of a model with "fill" as Gmsh fills it: the surface read from its file, placed by

@@ -25,7 +25,7 @@ MeshShape shape(MeshShape::Kind k, Vec3f size, float h) { return {k, size, h}; }
 
 TEST(GeneratedMesh, SheetHasTheEstimatedNodesAndTwoTrianglesANode) {
   const MeshShape s = shape(MeshShape::Kind::sheet, {0.5f, 0.f, 0.3f}, 0.01f);
-  Mesh m = generate_mesh(s);
+  Mesh m = generate_shape(s);
   const double n = double(m.position.size());
   EXPECT_NEAR(n, estimated_nodes(s), 0.1 * estimated_nodes(s));
   EXPECT_FALSE(m.volume());
@@ -40,7 +40,7 @@ TEST(GeneratedMesh, SheetHasTheEstimatedNodesAndTwoTrianglesANode) {
 
 TEST(GeneratedMesh, BoxIsAClosedManifoldVolume) {
   const MeshShape s = shape(MeshShape::Kind::box, {0.2f, 0.1f, 0.3f}, 0.01f);
-  Mesh mesh = generate_mesh(s);
+  Mesh mesh = generate_shape(s);
   ASSERT_TRUE(mesh.volume());
   const double n = double(mesh.position.size());
   EXPECT_NEAR(n, estimated_nodes(s), 0.1 * estimated_nodes(s));
@@ -71,7 +71,7 @@ TEST(GeneratedMesh, BoxIsAClosedManifoldVolume) {
 TEST(GeneratedMesh, SheetOnOneThreadIsTheSameMeshEachCall) {
   MeshShape s = shape(MeshShape::Kind::sheet, {0.4f, 0.f, 0.4f}, 0.003f);
   s.threads = 1;
-  const Mesh a = generate_mesh(s), b = generate_mesh(s);
+  const Mesh a = generate_shape(s), b = generate_shape(s);
   EXPECT_GT(a.position.size(), 10000u);
   EXPECT_EQ(a.position, b.position);
   EXPECT_EQ(a.triangle, b.triangle);
