@@ -39,8 +39,8 @@ class GmshSession {
 // it in errors.
 Mesh read_gmsh_model(const std::string& what);
 // The current Gmsh model into `path` as binary MSH 4.1, through a partial file beside it that
-// is renamed once Gmsh is done (a failed write leaves an existing file as it was); load_mesh
-// reads it back as the same mesh: nodes, their order and the elements.
+// is renamed once Gmsh is done (a failed write leaves an existing file as it was, and throws
+// WriteError); load_mesh reads it back as the same mesh: nodes, their order and the elements.
 void write_gmsh_model(const std::string& path);
 
 }  // namespace deformlab

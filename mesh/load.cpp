@@ -73,10 +73,12 @@ void write_gmsh_model(const std::string& path) {
     fs::rename(partial, to);
   } catch (const fs::filesystem_error& e) {
     fs::remove(partial, ec);
-    throw std::invalid_argument("writing '" + path + "': " + e.code().message());
+    throw WriteError("writing '" + path + "': " + e.code().message());
   } catch (...) {
     fs::remove(partial, ec);
-    throw;
+    std::string error;
+    gmsh::logger::getLastError(error);
+    throw WriteError("writing '" + path + "': " + (error.empty() ? "Gmsh failed" : error));
   }
 }
 

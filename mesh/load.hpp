@@ -2,11 +2,18 @@
 // reads), tetrahedral volumes from Gmsh's .msh through the Gmsh API, and a closed surface
 // filled with tetrahedra by Gmsh's 3D mesher.
 #pragma once
+#include <stdexcept>
 #include <string>
 
 #include "core/mesh_model.hpp"
 
 namespace deformlab {
+
+// A mesh file that could not be written: the message names that file, so callers that name
+// their input in errors leave this one as it is.
+struct WriteError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 
 // Reads a mesh as its library gives it (Gmsh: .msh, nodes in Gmsh's order; assimp: everything
 // else, vertices in the order assimp delivers them: for OBJ, the order in which faces first use
@@ -18,7 +25,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 
 // The closed surface filled with tetrahedra (Gmsh, its nodes kept); cell_size > 0 caps the
 // tetrahedra's edges. With `save_to`, Gmsh also writes the filled mesh there (write_gmsh_model).
-// Throws std::invalid_argument when Gmsh cannot fill it.
+// Throws std::invalid_argument when Gmsh cannot fill it, WriteError when it cannot write it.
 Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to = {});
 
 // The library versions, for manifests.

@@ -44,11 +44,14 @@ Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>
   return load_mesh(ms.file, notes);
 }
 
-// f(), with `what` before the message of its std::invalid_argument.
+// f(), with `what` before the message of its std::invalid_argument (a WriteError names its own
+// file).
 template <class F>
 auto naming(const std::string& what, F&& f) {
   try {
     return f();
+  } catch (const WriteError&) {
+    throw;
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(what + ": " + e.what());
   }
