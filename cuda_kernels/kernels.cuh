@@ -273,8 +273,8 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil s
       asm volatile("prefetch.global.L2 [%0];" ::"l"(v + node + prefetch));
     }
     const float4 x4 = x[node], v4 = v[node];
-    // grid_accel written out: through it this kernel measured 0.7-1.9% slower in fast math
-    // (H200, 2048^2 paper scene, explicit and semi-implicit Euler; docs/speed.md).
+    // grid_accel written out: through it this kernel measured about 1% slower on semi-implicit
+    // Euler (fast math in two calls, exact in one; H200, 2048^2 paper scene; docs/speed.md).
     Vec3f a{};
     if (!P::node_fixed(s, node, x4.w)) {
       const Vec3f xi = xyz(x4), vi = xyz(v4);
