@@ -17,7 +17,8 @@ struct Keyframe {
   Vec3f position;
 };
 
-// A node pulled along a keyframed path (linear between keys, held after the last).
+// A node pulled along a keyframed path (linear between keys, held before the first and after
+// the last; a scene's path starts at its node's rest position at t = 0: resolve_params).
 // Hard: the node is kinematic and sits on its target after every step. Spring: a spring of
 // `stiffness` pulls it towards the target, which the node then follows with some lag.
 struct DragHandle {

@@ -374,6 +374,11 @@ Params resolve_params(const Scene& s, const Model& m) {
     p.drag = {};
   }
   validate(p, m.node_count());
+  // The handle takes its node where it rests at t = 0: a path whose first key comes later
+  // starts with the way from there to that key, not with a jump onto it. (After the checks,
+  // whose messages count the scene's own keyframes.)
+  if (p.drag.active() && p.drag.path.front().t > 0.f)
+    p.drag.path.insert(p.drag.path.begin(), Keyframe{0.f, m.rest_position[p.drag.node]});
   return p;
 }
 

@@ -35,6 +35,13 @@ TEST(Scene, BuiltInExperimentIsThePapersDrag) {
   // Offsets in the file become positions relative to the node's rest position.
   EXPECT_EQ(p.drag.path.back().position, m.rest_position[p.drag.node]);
   EXPECT_TRUE(m.pinned(0) && m.pinned(127));
+  // The file's first key is at 0.5 s, 0.2 m down: the handle starts at the node's rest position
+  // and gets there linearly, so the node does not jump at the first step.
+  ASSERT_EQ(p.drag.path.size(), 5u);
+  EXPECT_EQ(p.drag.path[0].t, 0.f);
+  EXPECT_EQ(p.drag.target(0.0), m.rest_position[p.drag.node]);
+  EXPECT_NEAR(p.drag.target(0.25).y, m.rest_position[p.drag.node].y - 0.1f, 1e-6f);
+  EXPECT_NEAR(p.drag.target(0.5).y, m.rest_position[p.drag.node].y - 0.2f, 1e-6f);
 }
 
 TEST(Scene, ReadsEveryKeyAndRoundTrips) {
