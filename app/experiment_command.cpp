@@ -9,6 +9,7 @@
 #include "experiments/output.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
+#include "core/one_line.hpp"
 
 namespace deformlab::app {
 
@@ -26,17 +27,18 @@ int experiment_command(const ExperimentArgs& a) {
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
     }
   } catch (const std::invalid_argument& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
+    std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
   }
-  const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
+  const std::filesystem::path dir = a.out ? *a.out : "runs/" + (x.name.empty() ? std::string("experiment") : x.name);
   nlohmann::json calibration;
   try {
     require_folder_or_nothing(dir);
+    require_holds_nothing_but(dir, Holds::experiment);
     if (!a.report_only) require_same_experiment(dir, x.name);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
+    std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
   }
   return report_errors([&] {

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "experiments/experiment.hpp"
+#include "core/one_line.hpp"
 
 namespace deformlab::app {
 
@@ -11,10 +12,10 @@ int report_errors(const std::function<int()>& body) {
   try {
     return body();
   } catch (const std::invalid_argument& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
+    std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "deformlab: error: " << e.what() << "\n";
+    std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 1;
   }
 }
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return cli.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "deformlab: error: " << e.what() << " (see deformlab --help)\n";
+    std::cerr << "deformlab: error: " << deformlab::one_line(e.what()) << " (see deformlab --help)\n";
     return 2;
   }
   if (*run) return deformlab::app::run_command(a);

@@ -119,6 +119,9 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
 RunInput read_run_input(const RunArgs& a) {
   RunInput in;
   in.x = read_experiment(a);
+  in.out = a.out ? *a.out : "runs/" + (in.x.name.empty() ? std::string("run") : in.x.name);
+  require_folder_or_nothing(in.out);
+  require_holds_nothing_but(in.out, Holds::run);
   const auto i = parse_integrator(in.x.integrator);
   if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");
   in.integ = *i;

@@ -1,5 +1,7 @@
 // `deformlab run`'s input: everything read and checked before anything is written.
 #pragma once
+#include <filesystem>
+
 #include "commands.hpp"
 #include "core/model.hpp"
 #include "core/params.hpp"
@@ -17,6 +19,7 @@ struct RunInput {
   Model model;
   Params params;
   double build_s = 0.0;  // building the model, host clock
+  std::filesystem::path out;  // the output folder: --out, else runs/<experiment>
 };
 
 // "128x96" -> {128, 96}: `dims` positive integers; throws std::invalid_argument naming `flag`.

@@ -2,6 +2,7 @@
 #include <stdexcept>
 
 #include "bench.hpp"
+#include "core/one_line.hpp"
 
 int main(int argc, char** argv) {
   CLI::App cli{"deformlab-bench: timings of deformlab's pipelines (not tests)"};
@@ -22,10 +23,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return cli.exit(e) == 0 ? 0 : 2;
   } catch (const std::invalid_argument& e) {  // bad input
-    std::cerr << "deformlab-bench: error: " << e.what() << "\n";
+    std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "deformlab-bench: error: " << e.what() << "\n";
+    std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -1,5 +1,7 @@
 #include "experiment.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -12,7 +14,17 @@ namespace deformlab {
 
 using nlohmann::json;
 
+bool is_plain_name(const std::string& name) {
+  return !name.empty() && name != "." && name != ".." && std::all_of(name.begin(), name.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.';
+  });
+}
+
 namespace {
+
+// Experiments read inside one another through "base" now: a chain longer than this is a loop.
+thread_local int bases_open = 0;
+constexpr int kMaxBases = 16;
 
 Experiment from_json(const json& j, const std::string& where, const std::string& dir = "") {
   if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
@@ -20,6 +32,13 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
   // "base": start from another built-in experiment's scene and settings.
   if (j.contains("base")) {
     if (!j["base"].is_string()) throw std::invalid_argument(where + ".base: expected an experiment name");
+    if (bases_open == kMaxBases)
+      throw std::invalid_argument(where + ".base: more than " + std::to_string(kMaxBases) +
+                                  " experiments based on one another (a loop?)");
+    struct Open {
+      Open() { ++bases_open; }
+      ~Open() { --bases_open; }
+    } open;
     const Experiment b = load_experiment_by_name(j["base"].get<std::string>());
     x.pipeline = b.pipeline;
     x.integrator = b.integrator;
@@ -32,8 +51,10 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       if (!v.is_string()) throw std::invalid_argument(where + "." + k + ": expected a string");
       return v.get<std::string>();
     };
-    if (k == "name") x.name = str();
-    else if (k == "description") x.description = str();
+    if (k == "name") {
+      x.name = str();
+      if (!is_plain_name(x.name)) throw std::invalid_argument(where + ".name: " + kPlainName);
+    } else if (k == "description") x.description = str();
     else if (k == "pipeline") x.pipeline = str();
     else if (k == "integrator") x.integrator = str();
     else if (k == "until_converged") {

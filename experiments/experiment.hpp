@@ -18,6 +18,11 @@ struct Experiment {
   nlohmann::json raw;  // the whole file, for parts read elsewhere (the sweep) and manifests
 };
 
+// Whether `name` may name an experiment or a sweep's model, and so a folder or file: letters,
+// digits, '-', '_' and '.', not empty, not "." or "..".
+bool is_plain_name(const std::string& name);
+constexpr const char* kPlainName = "expected a name of letters, digits, '-', '_' and '.'";
+
 // Parses experiment JSON text; `where` names it in errors (file name or "built-in ...");
 // relative mesh files are taken from `dir`.
 Experiment parse_experiment(const std::string& text, const std::string& where, const std::string& dir = "");

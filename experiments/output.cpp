@@ -18,11 +18,34 @@
 namespace deformlab {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
 
 void require_folder_or_nothing(const fs::path& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
+}
+
+json read_manifest(const fs::path& dir) {
+  std::ifstream in(dir / "manifest.json");
+  if (!in) return nullptr;
+  json j = json::parse(in, nullptr, false);
+  return j.is_discarded() ? json(nullptr) : j;
+}
+
+Holds folder_holds(const fs::path& dir) {
+  std::error_code ec;
+  const json m = read_manifest(dir);
+  if (m.is_object() && m.contains("experiment")) return m["experiment"].is_object() ? Holds::experiment : Holds::run;
+  return fs::is_directory(dir / "cells", ec) ? Holds::experiment : Holds::nothing;
+}
+
+void require_holds_nothing_but(const fs::path& dir, Holds want) {
+  const Holds has = folder_holds(dir);
+  if (has == Holds::nothing || has == want) return;
+  throw std::invalid_argument("output folder '" + dir.string() + "' holds " +
+                              (has == Holds::run ? "a run's outputs" : "an experiment's results") +
+                              ": give this " + (want == Holds::run ? "run" : "experiment") + " another --out");
 }
 
 fs::path temporary(const fs::path& name) { return name.string() + ".tmp-" + std::to_string(::getpid()); }
@@ -42,7 +65,7 @@ void reclaim_temporaries(const fs::path& dir) {
   }
 }
 
-OutputDir::OutputDir(const fs::path& dir) : dir_(dir) {
+OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs) : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
   created_ = !fs::exists(dir_, ec);
@@ -62,6 +85,8 @@ OutputDir::~OutputDir() {
 
 void OutputDir::commit() {
   fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
+  for (const auto& name : outputs_)
+    if (!fs::exists(staging_ / name)) fs::remove_all(dir_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) {
     if (e.path().filename() == "manifest.json") continue;
     const fs::path target = dir_ / e.path().filename();

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/model.hpp"
 #include "core/run.hpp"
@@ -17,6 +18,17 @@ namespace deformlab {
 // Throws std::invalid_argument when `dir` exists and is not a folder.
 void require_folder_or_nothing(const std::filesystem::path& dir);
 
+// `dir`/manifest.json, or null when there is none or it is not JSON.
+nlohmann::json read_manifest(const std::filesystem::path& dir);
+
+// What a folder holds, by its manifest: one run's outputs (the manifest names its experiment),
+// an experiment's results (the manifest holds the experiment, or a sweep left cells/ before
+// writing one), or neither. One folder holds one of them.
+enum class Holds { nothing, run, experiment };
+Holds folder_holds(const std::filesystem::path& dir);
+// Throws std::invalid_argument when `dir` holds the other kind of output than `want`.
+void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
+
 // The temporary name of `name` for this process: "<name>.tmp-<pid>".
 std::filesystem::path temporary(const std::filesystem::path& name);
 // Removes the temporaries in `dir` ("*.tmp-<pid>", ".staging-<pid>") whose process is gone.
@@ -25,7 +37,9 @@ void reclaim_temporaries(const std::filesystem::path& dir);
 class OutputDir {
  public:
   // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder).
-  explicit OutputDir(const std::filesystem::path& dir);
+  // `outputs`: every name such an output may hold besides manifest.json; commit() removes
+  // those the new one does not write, so that the folder holds one output's files.
+  OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs);
   // Removes the staging folder, and the output folder too if this object created it and
   // nothing was committed.
   ~OutputDir();
@@ -35,12 +49,14 @@ class OutputDir {
   // Where to write a file or folder named `name` before commit().
   std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
   // Moves every staged entry into the output folder (replacing entries of the same name):
-  // the old manifest.json is removed first and the new one moved in last.
+  // the old manifest.json is removed first, then the old outputs the new one lacks, and the
+  // new manifest is moved in last.
   void commit();
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
   std::filesystem::path dir_, staging_;
+  std::vector<std::string> outputs_;
   bool created_ = false;
 };
 

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/clock_watch.hpp"
+#include "output.hpp"
 #include "paper.hpp"
 #include "plot.hpp"
 #include "report_parts.hpp"

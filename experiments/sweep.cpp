@@ -214,13 +214,6 @@ void write_atomically(const fs::path& file, const std::string& text) {
   fs::rename(tmp, file);
 }
 
-json read_manifest(const fs::path& dir) {
-  std::ifstream in(dir / "manifest.json");
-  if (!in) return nullptr;
-  json j = json::parse(in, nullptr, false);
-  return j.is_discarded() ? json(nullptr) : j;
-}
-
 namespace {
 
 // A cell file's result, or null when the file is not a cell result (damaged, edited).

@@ -103,8 +103,6 @@ nlohmann::json render_frames(const Experiment& x, const Sweep& s, const std::fil
 // Reads every cell result in `dir`/cells/.
 std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);
 
-// `dir`/manifest.json, or null when there is none or it is not JSON.
-nlohmann::json read_manifest(const std::filesystem::path& dir);
 // Throws std::invalid_argument when `dir` holds the results of another experiment than `name`.
 void require_same_experiment(const std::filesystem::path& dir, const std::string& name);
 

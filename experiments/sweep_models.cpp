@@ -28,10 +28,7 @@ std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& whe
     if (!e.is_object() || e.size() != 2 || !e.contains("name") || !e.contains("model"))
       bad(w, "expected {\"name\": ..., \"model\": {...}}");
     const std::string name = e["name"].is_string() ? e["name"].get<std::string>() : "";
-    const bool safe = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
-      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.';
-    });
-    if (!safe) bad(w + ".name", "expected a name of letters, digits, '-', '_' and '.'");
+    if (!is_plain_name(name)) bad(w + ".name", kPlainName);
     if (!names.insert(name).second) bad(w + ".name", "model '" + name + "' is named twice");
     Scene probe;
     probe.model.topology = Topology::general;

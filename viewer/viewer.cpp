@@ -18,6 +18,7 @@
 #include "recorder.hpp"
 #if DEFORMLAB_VIEWER_INTEROP
 #include "interop/gl_positions.hpp"
+#include "core/one_line.hpp"
 #endif
 
 #include <stb/stb_image_write.h>
@@ -64,7 +65,7 @@ class Viewer {
       if (rec_) finish_recording();
       if (!o_.save_script.empty()) write_script(o_.save_script, recorded_);
     } catch (const std::exception& e) {
-      std::cerr << "deformlab: error: " << e.what() << "\n";
+      std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
       code = 1;
     }
     if (!o_.summary.empty()) code = std::max(code, write_summary());

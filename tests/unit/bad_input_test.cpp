@@ -1,7 +1,8 @@
 // Every kind of bad input, one row each: flags, scene files (malformed, out of range, not a
 // file), experiment and calibration files. Each must exit 2 with one line naming the flag or
 // the file and key path, write nothing and leave an existing output folder as it was.
-// In the arguments, {dir} is the test's folder; the files of a row are written there first.
+// In the arguments and the files, {dir} is the test's folder; the files of a row are written
+// there first, and must be there as they were after the command.
 #include <set>
 #include <vector>
 
@@ -226,6 +227,20 @@ const std::vector<BadInput>& cases() {
        {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"generate": {"shape": "cone", "size": [1, 1], "cell_size": 1}}}], "pipelines": ["cpu"]}})"}}},
       {"sweep_models_max_size", "experiment {dir}/x.json --max-size 8", "--max-size: this sweep has models",
        {{"x.json", R"({"sweep": {"models": [{"name": "a", "model": {"file": "m.obj"}}], "pipelines": ["cpu"]}})"}}},
+      {"experiment_base_loop", "run --experiment {dir}/a.json", "experiments based on one another (a loop?)",
+       {{"a.json", R"({"base": "{dir}/b.json"})"}, {"b.json", R"({"base": "{dir}/a.json"})"}}},
+      {"experiment_name_path", "run --experiment {dir}/x.json", "x.json.name: expected a name of letters",
+       {{"x.json", R"({"name": "../escape"})"}}},
+      {"experiment_name_empty", "experiment {dir}/x.json", "x.json.name: expected a name of letters",
+       {{"x.json", R"({"name": "", "sweep": {"sizes": [8], "pipelines": ["cpu"]}})"}}},
+      scene("key_with_a_newline", "{\"d\\nt\": 1}", "s.json.d\\nt: unknown key"),
+      // a folder holds one run's outputs or one experiment's results
+      {"run_into_experiment_folder", "run --pipeline cpu --steps 3 --out {dir}",
+       "holds an experiment's results: give this run another --out", {{"manifest.json", R"({"experiment": {"name": "quick"}})"}}},
+      {"experiment_into_run_folder", "experiment quick --out {dir}", "holds a run's outputs: give this experiment another --out",
+       {{"manifest.json", R"({"experiment": "paper-drag"})"}}},
+      {"report_into_run_folder", "experiment quick --report-only --calibration {dir}/c.json --out {dir}",
+       "holds a run's outputs", {{"manifest.json", R"({"experiment": "paper-drag"})"}, {"c.json", R"({"copy": {"GB_per_s": 5}})"}}},
       {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_unknown_name", "experiment nosuch", "no experiment file or built-in experiment 'nosuch' (built in: "},
@@ -244,10 +259,17 @@ class Refused : public Cli, public testing::WithParamInterface<BadInput> {};
 
 TEST_P(Refused, WithOneLineAndNothingWritten) {
   const BadInput& c = GetParam();
-  for (const auto& [name, text] : c.files) std::ofstream(dir_ / name, std::ios::binary) << text;
-  std::string args = c.args;
-  for (std::size_t at; (at = args.find("{dir}")) != std::string::npos;) args.replace(at, 5, dir_.string());
-  expect_refused(args, c.needle);
+  auto in_dir = [&](std::string text) {
+    for (std::size_t at; (at = text.find("{dir}")) != std::string::npos;) text.replace(at, 5, dir_.string());
+    return text;
+  };
+  std::vector<std::pair<fs::path, std::string>> files;
+  for (const auto& [name, text] : c.files) {
+    files.emplace_back(dir_ / name, in_dir(text));
+    std::ofstream(files.back().first, std::ios::binary) << files.back().second;
+  }
+  expect_refused(in_dir(c.args), c.needle);
+  for (const auto& [file, text] : files) EXPECT_EQ(slurp(file), text) << file << " changed";
 }
 
 TEST(BadInputTable, HasAtLeastSixtyRowsWithDistinctNames) {

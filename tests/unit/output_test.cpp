@@ -1,5 +1,7 @@
 // Run outputs (experiments/output.hpp): a commit stopped between its renames leaves a folder
-// without a manifest, the mark of an incomplete run, and the next run's commit completes it.
+// without a manifest, the mark of an incomplete run, and the next run's commit completes it;
+// a commit leaves none of the old output's files that the new one lacks; a folder holds one
+// run or one experiment.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -20,6 +22,8 @@ std::string read(const fs::path& f) {
   return os.str();
 }
 
+const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames"};
+
 TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
   const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-stopped";
   fs::remove_all(dir);
@@ -28,7 +32,7 @@ TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
   write(dir / "manifest.json", "old");
   write(dir / "summary.txt", "old");
   {
-    OutputDir out(dir);
+    OutputDir out(dir, kOutputs);
     write(out.staged("summary.txt"), "new");
     write(out.staged("state.ply"), "new");
     write(out.staged("manifest.json"), "new");
@@ -37,7 +41,7 @@ TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
   }
   fs::remove_all(dir / "state.ply");
   {
-    OutputDir out(dir);
+    OutputDir out(dir, kOutputs);
     write(out.staged("summary.txt"), "newer");
     write(out.staged("state.ply"), "newer");
     write(out.staged("manifest.json"), "newer");
@@ -46,6 +50,44 @@ TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
   for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "newer") << f;
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << "staging left behind";
+  fs::remove_all(dir);
+}
+
+TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
+  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-stale";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "frames");
+  write(dir / "frames" / "frame_1.png", "old");
+  for (const char* f : {"manifest.json", "summary.txt", "state.ply", "trace.json", "notes.txt"}) write(dir / f, "old");
+  {
+    OutputDir out(dir, kOutputs);
+    write(out.staged("summary.txt"), "new");
+    write(out.staged("manifest.json"), "new");
+    out.commit();
+  }
+  EXPECT_EQ(read(dir / "manifest.json"), "new");
+  EXPECT_EQ(read(dir / "summary.txt"), "new");
+  for (const char* f : {"state.ply", "trace.json", "frames"}) EXPECT_FALSE(fs::exists(dir / f)) << f;
+  EXPECT_EQ(read(dir / "notes.txt"), "old") << "not an output: kept";
+  fs::remove_all(dir);
+}
+
+TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
+  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-folder-holds";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  EXPECT_EQ(folder_holds(dir), Holds::nothing);
+  EXPECT_NO_THROW(require_holds_nothing_but(dir, Holds::run));
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu"})");
+  EXPECT_EQ(folder_holds(dir), Holds::run);
+  EXPECT_NO_THROW(require_holds_nothing_but(dir, Holds::run));
+  EXPECT_THROW(require_holds_nothing_but(dir, Holds::experiment), std::invalid_argument);
+  write(dir / "manifest.json", R"({"experiment": {"name": "quick"}})");
+  EXPECT_EQ(folder_holds(dir), Holds::experiment);
+  EXPECT_THROW(require_holds_nothing_but(dir, Holds::run), std::invalid_argument);
+  fs::remove(dir / "manifest.json");
+  fs::create_directories(dir / "cells");  // a sweep stopped before its manifest
+  EXPECT_EQ(folder_holds(dir), Holds::experiment);
   fs::remove_all(dir);
 }
 
