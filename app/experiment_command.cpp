@@ -4,12 +4,13 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "core/one_line.hpp"
 #include "experiments/ceilings.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
-#include "core/one_line.hpp"
+#include "experiments/sweep_models.hpp"
 
 namespace deformlab::app {
 
@@ -26,6 +27,7 @@ int experiment_command(const ExperimentArgs& a) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
     }
+    require_model_files(x, *sweep);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;

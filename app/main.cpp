@@ -3,8 +3,8 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "experiments/experiment.hpp"
 #include "core/one_line.hpp"
+#include "experiments/experiment.hpp"
 
 namespace deformlab::app {
 

@@ -200,7 +200,12 @@ Model mesh_model(const Mesh& mesh, const Material& mat, float density) {
       for (auto v : t) mass[v] += density * tetrahedron_volume(mesh, t) / 4.0;
   }
   m.inv_mass.resize(n);
-  for (std::int64_t v = 0; v < n; ++v) m.inv_mass[v] = float(1.0 / mass[v]);
+  for (std::int64_t v = 0; v < n; ++v) {
+    m.inv_mass[v] = float(1.0 / mass[v]);
+    if (!std::isfinite(m.inv_mass[v]))
+      bad("node " + std::to_string(v) + "'s mass, " + std::to_string(mass[v]) +
+          " kg, is too small for float arithmetic (its inverse overflows): raise the density");
+  }
 
   std::vector<Key> edges, flexion;
   if (!mesh.volume()) {

@@ -1,7 +1,10 @@
 #include "scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -44,6 +47,11 @@ float num(const json& j, const std::string& where, Range r = Range::any) {
   if (!std::isfinite(d) || std::abs(d) > 3.0e38) bad(where, "expected a finite number");
   if (r == Range::positive && !(d > 0)) bad(where, "expected a number > 0");
   if (r == Range::non_negative && !(d >= 0)) bad(where, "expected a number >= 0");
+  // Read as float: a size, mass or constant under float's normal range would be 0 or a
+  // subnormal whose inverse overflows.
+  if (r != Range::any && d != 0 && d < std::numeric_limits<float>::min())
+    bad(where, std::string(r == Range::positive ? "expected a number of" : "expected 0 or a number of") +
+                   " at least 1.2e-38 (the smallest normal float)");
   return float(d);
 }
 
@@ -158,7 +166,15 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
 
 // "generate": {"shape": "sheet", "size": [w, d], "cell_size": h} or {"shape": "box", "size":
 // [w, h, d], ...}, optionally "threads": n; refused before meshing where it would make more
-// than 2^30 nodes.
+// than 2^30 nodes. Lengths lie within [1e-6, 1e6] m: outside that Gmsh's tolerances (relative
+// to the model's size) fail or spin.
+constexpr double kShortestLength = 1e-6, kLongestLength = 1e6;  // m
+float length(const json& j, const std::string& where) {
+  const float v = num(j, where, Range::positive);
+  if (v < float(kShortestLength) || v > float(kLongestLength)) bad(where, "expected a length within [1e-6, 1e6] m");
+  return v;
+}
+
 MeshShape shape(const json& j, const std::string& where) {
   only_keys(j, where, {"shape", "size", "cell_size", "threads"});
   for (const char* k : {"shape", "size", "cell_size"})
@@ -172,16 +188,20 @@ MeshShape shape(const json& j, const std::string& where) {
   if (!z.is_array() || z.size() != (sheet ? 2u : 3u))
     bad(where + ".size", sheet ? "expected [w, d] (m) for a sheet" : "expected [w, h, d] (m) for a box");
   for (std::size_t k = 0; k < z.size(); ++k) {
-    const float v = num(z[k], where + ".size[" + std::to_string(k) + "]", Range::positive);
+    const float v = length(z[k], where + ".size[" + std::to_string(k) + "]");
     s.size[sheet && k == 1 ? 2 : int(k)] = v;
   }
-  s.cell_size = num(j["cell_size"], where + ".cell_size", Range::positive);
+  s.cell_size = length(j["cell_size"], where + ".cell_size");
+
   if (j.contains("threads")) {
     s.threads = integer(j["threads"], where + ".threads", 1);
     if (s.threads > 1024) bad(where + ".threads", "expected at most 1024 threads");
   }
-  if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30))
-    bad(where + ".cell_size", "would make about " + std::to_string(std::int64_t(n)) + " nodes, over the limit of 2^30");
+  if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30)) {
+    std::ostringstream about;
+    about << std::setprecision(3) << n;
+    bad(where + ".cell_size", "would make about " + about.str() + " nodes, over the limit of 2^30");
+  }
   return s;
 }
 

@@ -1,6 +1,7 @@
 #include "sweep_models.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
@@ -50,6 +51,18 @@ std::vector<std::string> parse_sweep_orders(const json& j, const std::string& wh
     out.push_back(o.get<std::string>());
   }
   return out;
+}
+
+void require_model_files(const Experiment& x, const Sweep& s) {
+  for (const auto& m : s.models) {
+    Scene scene = x.scene;
+    scene.model.topology = Topology::general;
+    const std::string where = "sweep.models." + m.name;
+    apply_json(scene, {{"model", m.model}}, where, x.dir);
+    std::error_code ec;
+    const std::string& file = scene.model.mesh.file;
+    if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(where + ".model.file", "'" + file + "': no such file");
+  }
 }
 
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {

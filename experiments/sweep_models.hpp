@@ -16,6 +16,10 @@ std::vector<SweepModel> parse_sweep_models(const nlohmann::json& j, const std::s
 // "orders": node order names, distinct.
 std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::string& where);
 
+// Throws std::invalid_argument naming the first model whose mesh file is missing (relative
+// files from the experiment's folder): checked before the first cell runs.
+void require_model_files(const Experiment& x, const Sweep& s);
+
 // The experiment's scene with a model cell's model (relative files from the experiment's
 // folder) and order.
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c);

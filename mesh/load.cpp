@@ -6,7 +6,9 @@
 #include <assimp/version.h>
 #include <gmsh.h>
 
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -29,9 +31,21 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
                                                           aiComponent_TEXTURES | aiComponent_LIGHTS |
                                                           aiComponent_CAMERAS | aiComponent_MATERIALS);
   importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);  // one mesh per object: duplicates across them are welded (and counted) below
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+  // Read first, checked for coordinates that are not finite, then processed: joining identical
+  // vertices would otherwise merge a NaN vertex into another and hide it.
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+  if (!scene) bad(path, importer.GetErrorString());
+  for (unsigned k = 0; k < scene->mNumMeshes; ++k)
+    for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
+      if (const aiVector3D& p = scene->mMeshes[k]->mVertices[v];
+          !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        std::ostringstream at;
+        at << "a vertex has a NaN or infinite coordinate (" << p.x << ", " << p.y << ", " << p.z << ")";
+        bad(path, at.str());
+      }
+  scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                       aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
+                                       aiProcess_SortByPType | aiProcess_ValidateDataStructure);
   if (!scene) bad(path, importer.GetErrorString());
   Mesh m;
   std::int64_t points = 0, lines = 0;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "core/one_line.hpp"
 #include "core/run.hpp"
 #include "gl/context.hpp"
 #include "experiments/pipelines.hpp"
@@ -18,7 +19,6 @@
 #include "recorder.hpp"
 #if DEFORMLAB_VIEWER_INTEROP
 #include "interop/gl_positions.hpp"
-#include "core/one_line.hpp"
 #endif
 
 #include <stb/stb_image_write.h>
