@@ -8,16 +8,18 @@
 namespace deformlab::app {
 
 int list_command() {
-  std::cout << "Pipelines (in order of expected speed; 'best' picks the first available):\n";
+  std::cout << "Pipelines (in order of expected speed; 'best' picks the first available, passing over GL on a "
+               "software rasteriser):\n";
   for (const auto& e : pipelines().all()) {
     const std::string why = e.unavailable();
     std::cout << "  " << std::left << std::setw(15) << e.name << (why.empty() ? "available    " : "unavailable  ")
-              << e.summary << (e.traits.deterministic ? "" : " [not bitwise deterministic]") << "\n";
+              << e.summary << (e.traits.deterministic ? "" : " [not bitwise deterministic]")
+              << (on_software_gl(e) ? " [software GL: slower than the CPU pipelines here]" : "") << "\n";
+    for (const auto& o : e.options) std::cout << "  " << std::setw(15) << "" << "  option: " << o << "\n";
     if (!why.empty()) {
       std::cout << "  " << std::setw(15) << "" << "  why: " << why << "\n";
       continue;
     }
-    for (const auto& o : e.options) std::cout << "  " << std::setw(15) << "" << "  option: " << o << "\n";
     for (const auto& i : integrators())
       if (const auto no = e.unsupported(i.id); !no.empty())
         std::cout << "  " << std::setw(15) << "" << "  no " << i.name << ": " << no << "\n";

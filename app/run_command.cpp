@@ -64,6 +64,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   if (a.frames) {
     frames.emplace(in.model, dir.staged("frames"), *a.frames, gl::with_obstacles({}, in.params));
     opt.after_step = [&](int step) {
+      if (!frames->due(step)) return;  // a render span per frame, not per step
       HostSpan span(&profiler, span::render);
       frames->after_step(pipe, step);
     };

@@ -329,6 +329,10 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
       if (k > 0 && !(h.path[k].t > h.path[k - 1].t)) bad(w + "[0]", "keyframe times must increase");
     }
   }
+  // Keys absent keep the scene's: a drag over a scene without one names both.
+  if (d.node.kind == NodeSelector::Kind::index && d.node.index < 0)
+    bad(where, "needs \"node\" (the scene has no drag node to keep)");
+  if (h.path.empty()) bad(where, "needs \"path\" (the scene has no drag path to keep)");
 }
 
 }  // namespace

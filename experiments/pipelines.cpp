@@ -8,6 +8,7 @@
 #include "cuda_kernels/pipelines.hpp"
 #endif
 #if DEFORMLAB_HAVE_GL
+#include "gl/context.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines.hpp"
 #endif
@@ -116,9 +117,20 @@ std::string gpu_bus_id(const PipelineEntry& e) {
   return {};
 }
 
+bool on_software_gl(const PipelineEntry& e) {
+#if DEFORMLAB_HAVE_GL
+  auto is_gl = [](Engine x) { return x == Engine::gl_compute || x == Engine::gl_transform_feedback; };
+  const bool gl = is_gl(e.traits.force) || is_gl(e.traits.update);
+  return gl && e.unavailable().empty() && gl::context().software;
+#else
+  (void)e;
+  return false;
+#endif
+}
+
 const PipelineEntry& best_pipeline(Integrator i) {
   for (const auto& e : pipelines().all())
-    if (e.unavailable().empty() && e.unsupported(i).empty()) return e;
+    if (e.unavailable().empty() && e.unsupported(i).empty() && !on_software_gl(e)) return e;
   throw std::logic_error("no pipeline runs this integrator");
 }
 

@@ -13,7 +13,11 @@ const PipelineRegistry& pipelines();
 // where it cannot be told (GL without a CUDA device behind it: ClockWatch then reads NVML's
 // first GPU).
 std::string gpu_bus_id(const PipelineEntry& e);
-// The first pipeline in order of expected speed that is available here and runs `i`.
+// Whether `e` runs its passes on a software GL rasteriser (llvmpipe): slower than the CPU
+// pipelines, so `best` passes it over.
+bool on_software_gl(const PipelineEntry& e);
+// The first pipeline in order of expected speed that is available here, runs `i` and does not
+// run on a software rasteriser.
 const PipelineEntry& best_pipeline(Integrator i);
 
 }  // namespace deformlab

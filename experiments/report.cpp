@@ -259,7 +259,11 @@ void write_table(Report& r, const Table& t) {
     r.md << "\n";
   }
   const std::string svg = "plot-" + t.title + ".svg";
-  plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes", "ms per step (dashed: paper, ms per frame)", series);
+  std::erase_if(series, [](const plot::Series& s) { return s.x.empty(); });  // no cell measured: no legend entry
+  const bool paper = std::any_of(series.begin(), series.end(), [](const plot::Series& s) { return s.dashed; });
+  plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes",
+               std::string("ms per step, each on its pipeline's step clock") + (paper ? " (dashed: paper, ms per frame)" : ""),
+               series);
   r.md << "\n![" << t.title << "](" << svg << ")\n\n";
   if (r.ceil.any() && r.sweep.time == "update") write_ceiling_table(r.md, t.columns, r.results, r.ceil);
 }
@@ -276,7 +280,12 @@ void write_frames(Report& r) {
   r.md << "The experiment's own scene (" << frames.value("nodes", 0) << " nodes) on `"
        << frames.value("pipeline", std::string()) << "`, " << frames.value("integrator", std::string()) << ", a "
        << size[0] << " x " << size[1] << " frame every " << frames.value("every_steps", 0) << " steps of "
-       << frames.value("steps", 0) << "; the camera frames the rest pose.\n\n";
+       << frames.value("steps", 0);
+  // The frames cover 1.25 x the drag path, as far as the scene's max_steps lets them.
+  const double shown = frames.value("steps", 0) * frames.value("dt_s", 0.0), drag = frames.value("drag_end_s", 0.0);
+  if (shown > 0 && drag > shown)
+    r.md << " (" << fmt(shown) << " s: the scene's max_steps cuts the " << fmt(drag) << " s drag path short)";
+  r.md << "; the camera frames the rest pose.\n\n";
   for (const auto& f : frames["files"]) r.md << "![" << f.get<std::string>() << "](" << f.get<std::string>() << ") ";
   r.md << "\n\n";
 }

@@ -188,8 +188,10 @@ void write_stages(std::ostringstream& md, const fs::path& dir, const std::string
   const std::vector<Group> groups = stage_groups(sweep, cells);
   if (groups.empty()) return;
   md << "## Where a step's time goes\n\n"
-        "Stage times are medians per step over one more batch run with the profiler attached, each by its own "
-        "clock (CUDA events, GL timer queries); \"rest\" is the timed step less its GPU stages: hand-offs, "
+        "Stage times are medians per step over one more batch run with the profiler attached, each by the "
+        "clock its pipeline times stages with (CUDA events; GL timer queries, or the host clock after glFinish "
+        "on a software renderer, whose timer queries mean nothing); \"rest\" is the timed step less its GPU "
+        "stages: hand-offs, "
         "waits and launch gaps. Host-clock columns are CPU time inside those calls. The stages run one launch "
         "at a time there, where the timed steps may replay a graph, so at small sizes they can add up to more "
         "than the step (bars past 100%).";

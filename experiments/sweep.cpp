@@ -191,6 +191,7 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
     j["nodes"] = m.node_count();
     j["steps"] = r.steps;
     j["dt_s"] = p.dt;
+    j["drag_end_s"] = p.drag.end_time();
     j["files"] = files;
     return j;
   } catch (const std::exception& ex) {

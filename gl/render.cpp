@@ -483,7 +483,7 @@ void FrameWriter::write(Pipeline& p, int step) {
 }
 
 void FrameWriter::after_step(Pipeline& p, int step) {
-  if (step % every_ == 0) write(p, step);
+  if (due(step)) write(p, step);
 }
 
 void FrameWriter::finish(Pipeline& p, int last_step) {

@@ -111,7 +111,8 @@ class Renderer {
 class FrameWriter {
  public:
   FrameWriter(const Model& m, std::filesystem::path dir, int every, RenderOptions o = {});
-  void after_step(Pipeline& p, int step);     // writes a frame when step % every == 0
+  bool due(int step) const { return step % every_ == 0; }
+  void after_step(Pipeline& p, int step);     // writes a frame when due(step)
   void finish(Pipeline& p, int last_step);  // the final frame (if not written), then the MP4
   nlohmann::json manifest() const;          // frames written, render times, how timed
 

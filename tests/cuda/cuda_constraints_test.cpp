@@ -1,5 +1,7 @@
 // Constraints on the CUDA pipelines: pins, the ground, spheres and both drag modes hold,
-// and the steps match the CPU's (tolerances as in cuda_pipeline_test.cpp).
+// and the steps match the CPU's: bit for bit where the gather sums in the CPU's order; for
+// cuda-scatter (atomic sums in any order) within 4 x the CPU float pipeline's own distance
+// from the double reference plus 4 ulps of the largest coordinate (rounding_floor).
 #include <gtest/gtest.h>
 
 #include "cuda_test_support.hpp"

@@ -129,6 +129,10 @@ TEST(GlCommand, RunWritesFramesAndGlFacts) {
   const Command c = run_deformlab("", "run -p glsl-compute --grid 16x16 --steps 12 --frames 5 -o '" + (dir / "out").string() + "'");
   EXPECT_EQ(c.exit_code, 0) << c.output;
   EXPECT_EQ(pass_spans(), 8);
+  std::ifstream spans(dir / "out" / "spans.csv");
+  int render_spans = 0;
+  for (std::string line; std::getline(spans, line);) render_spans += line.rfind("render,", 0) == 0;
+  EXPECT_EQ(render_spans, 2) << "one span a frame rendered after a step (5 and 10), none for the steps between";
   for (const char* f : {"frame_000005.png", "frame_000010.png", "frame_000012.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frames" / f)) << f;
   std::ifstream manifest(dir / "out" / "manifest.json");

@@ -1,9 +1,8 @@
 // The GL update passes fed by an outside force stage and driven by the schedule runner (what
 // the hybrid pipelines do with CUDA), here with the accelerations computed on the host from
 // the state GL wrote, so that the GL side of the hybrid step is checked on any GL driver
-// (llvmpipe in CI). Tolerance:
-// as for the hybrid pipelines (hybrid_test.cpp): 8 x the CPU float pipeline's own distance
-// from the double reference, with a floor of 1e-6 m and 1e-4 m/s.
+// (llvmpipe in CI). Tolerance, as the match tests' (tests/match/match_cpu_test.cpp): 8 x the CPU
+// float pipeline's own distance from the double reference, with a floor of 1e-6 m and 1e-4 m/s.
 #include <gtest/gtest.h>
 
 #include "core/cpu_backend.hpp"

@@ -101,7 +101,7 @@ TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
   const std::string at = "mesh file '" + (dir_ / "").string();
   EXPECT_EQ(error("none.obj", ""), at + "none.obj': no such file");
   EXPECT_EQ(error("e.obj", ""), at + "e.obj': the file is empty");
-  EXPECT_EQ(error("n.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), at + "n.obj': vertex 0 has a NaN or infinite coordinate");
+  EXPECT_EQ(error("n.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), at + "n.obj': a vertex has a NaN or infinite coordinate (nan, 0, 0)");
   EXPECT_EQ(error("l.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"), at + "l.obj': no triangles");
   std::string stl(80, ' ');
   stl += std::string("\x0c\0\0\0", 4) + std::string(50, '\0');  // 12 triangles announced, one there

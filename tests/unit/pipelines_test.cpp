@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/integrator.hpp"
 #include "core/timed_work.hpp"
 #include "experiments/pipelines.hpp"
 
@@ -35,6 +36,21 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_EQ(cpu_match(*r.find("cuda-fused"), {{"math", "fast"}}), CpuMatch::rounding);
   EXPECT_EQ(cpu_match(*r.find("cuda-fused"), {{"math", "exact"}}), CpuMatch::bitwise);
   EXPECT_THROW(math_option({{"math", "quick"}}), std::invalid_argument);
+}
+
+// `best` is the first pipeline of the list that runs here, runs the integrator and does not run
+// on a software rasteriser (on a machine with llvmpipe only, a CPU pipeline).
+TEST(Pipelines, BestIsTheFirstThatRunsHereOffSoftwareGl) {
+  for (const auto& i : integrators()) {
+    const PipelineEntry& best = best_pipeline(i.id);
+    EXPECT_TRUE(best.unavailable().empty() && best.unsupported(i.id).empty()) << best.name;
+    EXPECT_FALSE(on_software_gl(best)) << best.name;
+    for (const auto& e : pipelines().all()) {
+      if (e.name == best.name) break;
+      EXPECT_TRUE(!e.unavailable().empty() || !e.unsupported(i.id).empty() || on_software_gl(e))
+          << e.name << " comes before " << best.name << " and runs " << i.name << " here";
+    }
+  }
 }
 
 TEST(Pipelines, WarmUpEndsWithinAboutAStepOfItsTime) {
