@@ -82,8 +82,12 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
 
   void step() override {
     run_passes(sched_, t_, p_.dt, *this, *this);
+    HostSpan span(sampling(prof_), span::constraints);
     constrain_and_commit();
   }
+
+  // The passes are timed by the host clock in the profiler's sampled steps.
+  void set_profiler(Profiler* p) override { prof_ = p; }
 
   double max_displacement() override { return last_disp_; }
 
@@ -114,9 +118,13 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     return f;
   }
 
-  void forces(int src, int acc, double t) override { force(slots_[src], acc_[acc], t); }
+  void forces(int src, int acc, double t) override {
+    HostSpan span(sampling(prof_), span::force);
+    force(slots_[src], acc_[acc], t);
+  }
 
   void update(const Pass& pass) override {
+    HostSpan span(sampling(prof_), span::update);
     switch (pass.op) {
       case Pass::Op::combine: return combine(pass);
       case Pass::Op::update: return one_pass();
@@ -268,6 +276,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
   std::vector<std::vector<V>> acc_;
   Slot next_;
   std::vector<V> x_prev_;
+  Profiler* prof_ = nullptr;
   bool has_prev_ = false;
   double t_ = 0.0;
   double last_disp_ = 0.0;

@@ -1,6 +1,7 @@
 // The deformlab command end to end: the outputs of a run and what a failed run leaves
 // (bad inputs: bad_input_test.cpp).
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "cli_support.hpp"
@@ -34,6 +35,12 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_GT(m["result"]["median_step_ms"].get<double>(), 0.0);
   EXPECT_NE(r.out.find("ms/step (host clock), "), std::string::npos) << r.out;
   EXPECT_EQ(m["stages_timed_in"], "steps 1-8 of every 64");
+  std::set<std::string> stages;
+  for (const auto& st : m["stages"]) {
+    stages.insert(st["name"].get<std::string>());
+    EXPECT_EQ(st["clock"], "host clock") << st;
+  }
+  for (const char* name : {"force", "update", "constraints", "step"}) EXPECT_EQ(stages.count(name), 1u) << name;
   EXPECT_NE(r.out.find("passes timed in steps 1-8 of every 64"), std::string::npos) << r.out;
   EXPECT_EQ(m["scene"]["model"]["size"], nlohmann::json::array({8, 6}));
   EXPECT_EQ(m["warm_up"]["steps"], 0) << "CPU pipelines start at once";
