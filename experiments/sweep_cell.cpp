@@ -198,7 +198,9 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, const Pipel
   const std::vector<double> ms = timed_batches(pipe, timer.get(), steps, s, per_batch);
   const ClockSummary clock = watch ? watch->stop() : ClockSummary{};
   const double d = pipe.max_displacement();
-  if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
+  // A report's stage tables show where a GPU pipeline's step goes; the CPU's passes are plain loops.
+  if (gpu)
+    if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
   r["status"] = "ok";
   r["median_ms"] = median(ms);
   r["min_ms"] = *std::min_element(ms.begin(), ms.end());
