@@ -42,10 +42,11 @@ int main(int argc, char** argv) {
   run->add_option("--threshold", a.threshold, "Convergence threshold, m per step");
   run->add_option("--check-every", a.check_every, "Steps between convergence and divergence checks");
   run->add_option("--option", a.options, "Pipeline option NAME=VALUE (repeatable; 'deformlab list' names them)");
-  run->add_option("--compare", a.compare, "Also run the double-precision reference ('cpu') and report the error");
+  run->add_option("--compare", a.compare, "Also run the double-precision pipeline 'reference' and report the error");
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
-  run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)");
+  run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)")
+      ->check(CLI::NonNegativeNumber);
   run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");
   run->add_option("--warmup-ms", a.warmup_ms,
                   "Untimed steps from rest for at least this long before the run, which then starts from rest "

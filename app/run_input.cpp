@@ -56,7 +56,8 @@ PipelineOptions parse_options(const std::vector<std::string>& flags, const Pipel
   for (const auto& o : flags) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0) throw BadInput("--option '" + o + "': expected NAME=VALUE");
-    options[o.substr(0, eq)] = o.substr(eq + 1);
+    if (!options.emplace(o.substr(0, eq), o.substr(eq + 1)).second)
+      throw BadInput("--option '" + o + "': option '" + o.substr(0, eq) + "' is given twice");
   }
   try {
     check_options(entry, options);
@@ -131,8 +132,8 @@ RunInput read_run_input(const RunArgs& a) {
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
-  if (a.compare && *a.compare != "cpu")
-    throw BadInput("--compare '" + *a.compare + "': the only reference is 'cpu' (double precision)");
+  if (a.compare && *a.compare != "reference")
+    throw BadInput("--compare '" + *a.compare + "': the only pipeline to compare with is 'reference' (double precision)");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));

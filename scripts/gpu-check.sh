@@ -243,7 +243,7 @@ fi
 
 # The largest grids: 20 steps with the stop rule checked every step (state.ply left out: 13 GB
 # at 16384^2), device memory sampled by nvidia-smi, a frame of a 16384^2 cloth drawn from GL
-# buffers and from a CUDA state; then --compare cpu at 1024^2 and 96^3.
+# buffers and from a CUDA state; then --compare reference at 1024^2 and 96^3.
 scale_run() {  # name, then run arguments
   local name=$1; shift
   nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits -lms 100 >"$out/scale-$name.gpumem" 2>/dev/null &
@@ -271,8 +271,8 @@ if part scale; then
   scale_run glsl-compute-frames16384 --pipeline glsl-compute --grid 16384x16384 --frames 20
   scale_run cuda-fused-frames16384 --pipeline cuda-fused --grid 16384x16384 --frames 20
   for p in cuda-fused cuda-naive glsl-compute glsl-tf; do
-    scale_run "$p-compare1024" --pipeline "$p" --grid 1024x1024 --compare cpu
-    scale_run "$p-compare96" --pipeline "$p" --lattice 96x96x96 --compare cpu
+    scale_run "$p-compare1024" --pipeline "$p" --grid 1024x1024 --compare reference
+    scale_run "$p-compare96" --pipeline "$p" --lattice 96x96x96 --compare reference
   done
 fi
 

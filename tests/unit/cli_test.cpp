@@ -11,7 +11,7 @@ namespace {
 
 TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   const fs::path out = dir_ / "run";
-  const Result r = run("run --pipeline cpu --integrator verlet --grid 8x6 --steps 10 --compare cpu --out " + out.string());
+  const Result r = run("run --pipeline cpu --integrator verlet --grid 8x6 --steps 10 --compare reference --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("48 nodes"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("compare: largest position error"), std::string::npos) << r.out;
