@@ -165,7 +165,10 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"machine", machine_info()}};
   if (a.trace) manifest["files"]["trace.json"] = "Chrome trace of the spans (open in Perfetto: ui.perfetto.dev)";
   if (a.no_state) manifest["files"].erase("state.ply");
-  if (!ran.frames.is_null()) manifest["frames"] = ran.frames;
+  if (!ran.frames.is_null()) {
+    manifest["frames"] = ran.frames;
+    manifest["files"]["frames/"] = "PNG frames (and frames.mp4 where ffmpeg is installed); see frames";
+  }
   return manifest;
 }
 
@@ -223,7 +226,7 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
     std::cout << "; device " << mem["pipeline_device_bytes"].get<double>() / nodes << " B ("
               << gib(mem["pipeline_device_bytes"]) << ")";
   std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
-            << "manifest.json" << (a.trace ? ", trace.json" : "") << "}\n";
+            << "manifest.json" << (a.trace ? ", trace.json" : "") << (a.frames ? ", frames/" : "") << "}\n";
 }
 
 }  // namespace
