@@ -408,6 +408,10 @@ Params resolve_params(const Scene& s, const Model& m) {
 
 const char* to_string(MeshShape::Kind k) { return k == MeshShape::Kind::sheet ? "sheet" : "box"; }
 
+double estimated_filled_nodes(double volume, double cell_size) {
+  return kBoxPerVolume * volume / (double(cell_size) * cell_size * cell_size);
+}
+
 double estimated_nodes(const MeshShape& s) {
   const double h = s.cell_size, x = s.size.x, y = s.size.y, z = s.size.z;
   if (s.kind == MeshShape::Kind::sheet) return kSheetPerArea * x * z / (h * h) + kSheetPerRim * 2 * (x + z) / h;

@@ -27,6 +27,9 @@ const char* to_string(MeshShape::Kind k);
 // The nodes Gmsh makes of a shape, estimated from its area and rim (a sheet) or volume and
 // surface (a box), as measured on Gmsh 4.8's meshes: within 1% from 50 k nodes up.
 double estimated_nodes(const MeshShape& s);
+// The nodes Gmsh makes filling `volume` m^3 with tetrahedra of `cell_size`, by the same measure
+// (its interior's share, which dominates at sizes worth estimating).
+double estimated_filled_nodes(double volume, double cell_size);
 // "Gmsh box 0.4 x 0.4 x 0.4 m, cell 0.00347 m" (and its threads where set).
 std::string describe(const MeshShape& s);
 

@@ -1,6 +1,9 @@
 #include "scene_model.hpp"
 
+#include <cmath>
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/memory.hpp"
@@ -57,6 +60,30 @@ auto naming(const std::string& what, F&& f) {
   }
 }
 
+// Refuses a fill whose tetrahedra of `cell_size` would make more than 2^30 nodes, or a model
+// that would not fit, estimated from the volume the surface encloses (before meshing).
+void check_fill_size(const Mesh& surface, float cell_size) {
+  double volume = 0;  // the divergence theorem over the (closed, consistently wound) triangles
+  for (const auto& t : surface.triangle) {
+    auto at = [&](std::int32_t v) {
+      const Vec3f& p = surface.position[v];
+      return Vec3d{p.x, p.y, p.z};
+    };
+    const Vec3d a = at(t[0]), b = at(t[1]), c = at(t[2]);
+    volume += dot(a, cross(b, c)) / 6.0;
+  }
+  const double n = estimated_filled_nodes(std::abs(volume), cell_size);
+  std::ostringstream about;
+  about << "filling with tetrahedra of cell_size " << cell_size << " m would make about " << std::setprecision(3) << n
+        << " nodes";
+  if (n > double(std::int64_t(1) << 30)) throw std::invalid_argument(about.str() + ", over the limit of 2^30");
+  try {
+    check_memory(std::int64_t(n), std::int64_t(n * 16), std::int64_t(n * 6.6));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(about.str() + ": " + e.what());
+  }
+}
+
 // The mesh a spec's model is made of: read or generated, placed by its scale and transform,
 // repaired and, with "fill", filled with tetrahedra (the filled mesh also written to `fill_to`
 // when given); `what` names it in errors.
@@ -68,6 +95,7 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
     for (auto& line : repair(mesh)) notes.push_back(std::move(line));
     if (ms.fill) {
       if (mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
+      if (ms.cell_size > 0) check_fill_size(mesh, ms.cell_size);
       mesh = fill_tetrahedra(mesh, ms.cell_size, fill_to);
       for (auto& line : repair(mesh)) notes.push_back("after filling: " + line);
     }
