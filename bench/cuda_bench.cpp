@@ -134,7 +134,8 @@ void run_cuda(const CudaOptions& o) {
   for (const auto& t : o.tiles) cuda::parse_tile(t);  // bad tiles refused before anything runs
   for (const auto& t : o.temporal_tiles)
     if (t != "default") cuda::parse_temporal_tile(t);
-  if (const std::string why = cuda::unavailable(); !why.empty()) throw std::runtime_error(why);
+  // Asked of a machine without CUDA: refused like deformlab's CUDA pipelines there (exit 2).
+  if (const std::string why = cuda::unavailable(); !why.empty()) throw std::invalid_argument(why);
 
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;

@@ -7,6 +7,7 @@
 int main(int argc, char** argv) {
   CLI::App cli{"deformlab-bench: timings of deformlab's pipelines (not tests)"};
   cli.require_subcommand(1);
+  cli.option_defaults()->always_capture_default();  // --help shows each option's default
   deformlab::bench::add_cpu_bench(cli);
 #if DEFORMLAB_HAVE_CUDA
   deformlab::bench::add_cuda_bench(cli);
