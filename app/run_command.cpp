@@ -177,7 +177,8 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   const Model& m = in.model;
   const RunResult& r = ran.result;
   const WarmUp& warm = ran.warm_up;
-  std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name) << " on " << in.entry->name << " ("
+  std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name)
+            << (a.scene ? " with scene " + *a.scene : std::string()) << " on " << in.entry->name << " ("
             << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
             << m.spring_count() << " springs\n";
   for (const auto& [name, value] : pipe.chosen_options())
