@@ -237,7 +237,9 @@ std::vector<json> load_cells(const fs::path& dir) {
   for (const auto& f : files) {
     json j = read_cell(f);
     if (j.is_null())
-      throw std::invalid_argument("cell file " + f.string() + " is not a cell result (run the experiment again to redo it)");
+      throw std::invalid_argument("cell file " + f.string() +
+                                  " is not a cell result: if it is one of the sweep's cells, running the experiment "
+                                  "again redoes it; else remove it");
     out.push_back(std::move(j));
   }
   return out;

@@ -6,8 +6,10 @@
 #include <assimp/version.h>
 #include <gmsh.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -22,7 +24,22 @@ namespace {
   throw std::invalid_argument("mesh file '" + file + "': " + what);
 }
 
+// assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
+// file is refused first (the header is text, within its first 64 KiB in any file we know).
+void require_ply_header_end(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".ply") return;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(in.gcount()));
+  if (head.find("end_header") == std::string::npos)
+    bad(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
+}
+
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
+  require_ply_header_end(path);
   Assimp::Importer importer;
   // Positions only, so that joining identical vertices looks at positions alone.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |

@@ -139,6 +139,8 @@ const std::vector<BadInput>& cases() {
            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n",
            "m.ply"),
+      mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
+           "ply\nformat ascii 1.0\n", "m.ply"),
       mesh("mesh_density_tiny", "{\"file\": \"m.obj\", \"density\": 1.2e-38}", "is too small for float arithmetic"),
       scene("stiffness_subnormal", "{\"model\": {\"stiffness\": 1e-46}}",
             "s.json.model.stiffness: expected a number of at least 1.2e-38 (the smallest normal float)"),
