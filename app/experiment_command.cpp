@@ -27,7 +27,7 @@ int experiment_command(const ExperimentArgs& a) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
     }
-    require_model_files(x, *sweep);
+    if (!a.report_only) require_model_files(x, *sweep, a.file);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;

@@ -3,6 +3,7 @@
 
 #include "commands.hpp"
 #include "core/integrator.hpp"
+#include "experiments/experiment.hpp"
 #include "experiments/pipelines.hpp"
 
 namespace deformlab::app {
@@ -24,6 +25,9 @@ int list_command() {
       if (const auto no = e.unsupported(i.id); !no.empty())
         std::cout << "  " << std::setw(15) << "" << "  no " << i.name << ": " << no << "\n";
   }
+  const Integrator usual = *parse_integrator(default_experiment().integrator);
+  std::cout << "\n'best' here: " << best_pipeline(usual).name << " (for " << info(usual).name
+            << ", the main job's integrator)\n";
   std::cout << "\nIntegrators (name, paper's name, force passes per step, order):\n";
   for (const auto& i : integrators())
     std::cout << "  " << std::left << std::setw(21) << i.name << std::setw(18)

@@ -117,12 +117,15 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
   return out;
 }
 
-RunInput read_run_input(const RunArgs& a) {
+RunInput read_run_input(const RunArgs& a, Output output) {
   RunInput in;
   in.x = read_experiment(a);
-  in.out = a.out ? *a.out : "runs/" + (in.x.name.empty() ? std::string("run") : in.x.name);
-  require_folder_or_nothing(in.out);
-  require_holds_nothing_but(in.out, Holds::run);
+  if (output == Output::folder) {
+    const std::string name = in.x.name.empty() ? std::string("run") : in.x.name;
+    in.out = a.out ? *a.out : "runs/" + name + (in.x.raw.contains("sweep") ? "-run" : "");
+    require_folder_or_nothing(in.out);
+    require_holds_nothing_but(in.out, Holds::run);
+  }
   const auto i = parse_integrator(in.x.integrator);
   if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");
   in.integ = *i;

@@ -19,7 +19,8 @@ struct RunInput {
   Model model;
   Params params;
   double build_s = 0.0;  // building the model, host clock
-  std::filesystem::path out;  // the output folder: --out, else runs/<experiment>
+  std::filesystem::path out;  // `run`'s output folder: --out, else runs/<experiment> (runs/<experiment>-run
+                              // for an experiment with a sweep, whose folder is `experiment`'s)
 };
 
 // "128x96" -> {128, 96}: `dims` positive integers; throws std::invalid_argument naming `flag`.
@@ -28,6 +29,8 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag);
 // Reads the experiment or scene, applies the flags and builds the model; bad input
 // (unknown names, bad sizes or numbers, a model too large for memory) throws
 // std::invalid_argument with one line saying what is wrong.
-RunInput read_run_input(const RunArgs& a);
+// `run`'s output folder is checked first, before the model is built; `view` writes none.
+enum class Output { folder, none };
+RunInput read_run_input(const RunArgs& a, Output output = Output::folder);
 
 }  // namespace deformlab::app

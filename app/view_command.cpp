@@ -28,7 +28,7 @@ int view_command(const ViewArgs& a) {
     o.frames = a.max_frames.value_or(0);
     o.summary = a.summary.value_or("");
     viewer::Window w(size[0] + viewer::kPanelWidth, size[1], "deformlab view");
-    RunInput in = read_run_input(a.run);
+    RunInput in = read_run_input(a.run, Output::none);
     w.set_title("deformlab view: " + describe(in.x.scene.model));
     viewer::Session s({std::move(in.model), in.params, in.entry, in.integ, in.options});
     return viewer::run(w, s, o);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <parallel/algorithm>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 
@@ -202,9 +203,12 @@ Model mesh_model(const Mesh& mesh, const Material& mat, float density) {
   m.inv_mass.resize(n);
   for (std::int64_t v = 0; v < n; ++v) {
     m.inv_mass[v] = float(1.0 / mass[v]);
-    if (!std::isfinite(m.inv_mass[v]))
-      bad("node " + std::to_string(v) + "'s mass, " + std::to_string(mass[v]) +
-          " kg, is too small for float arithmetic (its inverse overflows): raise the density");
+    if (!std::isfinite(m.inv_mass[v])) {
+      std::ostringstream what;
+      what << "node " << v << "'s mass, " << mass[v] << " kg, is too small for float arithmetic (its inverse "
+           << "overflows): raise the density";
+      bad(what.str());
+    }
   }
 
   std::vector<Key> edges, flexion;

@@ -1,6 +1,5 @@
 #include "scene.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -51,7 +50,7 @@ float num(const json& j, const std::string& where, Range r = Range::any) {
   // subnormal whose inverse overflows.
   if (r != Range::any && d != 0 && d < std::numeric_limits<float>::min())
     bad(where, std::string(r == Range::positive ? "expected a number of" : "expected 0 or a number of") +
-                   " at least 1.2e-38 (the smallest normal float)");
+                   " at least 1.18e-38 (the smallest normal float)");
   return float(d);
 }
 

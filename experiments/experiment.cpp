@@ -29,7 +29,7 @@ constexpr int kMaxBases = 16;
 Experiment from_json(const json& j, const std::string& where, const std::string& dir = "") {
   if (!j.is_object()) throw std::invalid_argument(where + ": expected a JSON object");
   Experiment x;
-  // "base": start from another built-in experiment's scene and settings.
+  // "base": start from another experiment's scene and settings (a built-in name or a file).
   if (j.contains("base")) {
     if (!j["base"].is_string()) throw std::invalid_argument(where + ".base: expected an experiment name");
     if (bases_open == kMaxBases)

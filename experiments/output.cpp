@@ -69,6 +69,7 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs) : di
   std::error_code ec;
   require_folder_or_nothing(dir_);
   created_ = !fs::exists(dir_, ec);
+  held_output_ = folder_holds(dir_) == Holds::run;
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
   reclaim_temporaries(dir_);
@@ -86,7 +87,7 @@ OutputDir::~OutputDir() {
 void OutputDir::commit() {
   fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
   for (const auto& name : outputs_)
-    if (!fs::exists(staging_ / name)) fs::remove_all(dir_ / name);
+    if (held_output_ && !fs::exists(staging_ / name)) fs::remove_all(dir_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) {
     if (e.path().filename() == "manifest.json") continue;
     const fs::path target = dir_ / e.path().filename();

@@ -53,15 +53,15 @@ std::vector<std::string> parse_sweep_orders(const json& j, const std::string& wh
   return out;
 }
 
-void require_model_files(const Experiment& x, const Sweep& s) {
-  for (const auto& m : s.models) {
+void require_model_files(const Experiment& x, const Sweep& s, const std::string& where) {
+  for (std::size_t k = 0; k < s.models.size(); ++k) {
+    const std::string w = where + ".sweep.models[" + std::to_string(k) + "].model";
     Scene scene = x.scene;
     scene.model.topology = Topology::general;
-    const std::string where = "sweep.models." + m.name;
-    apply_json(scene, {{"model", m.model}}, where, x.dir);
+    apply_json(scene, {{"model", s.models[k].model}}, w, x.dir);
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
-    if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(where + ".model.file", "'" + file + "': no such file");
+    if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
   }
 }
 

@@ -58,7 +58,8 @@ TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
   fs::remove_all(dir);
   fs::create_directories(dir / "frames");
   write(dir / "frames" / "frame_1.png", "old");
-  for (const char* f : {"manifest.json", "summary.txt", "state.ply", "trace.json", "notes.txt"}) write(dir / f, "old");
+  for (const char* f : {"summary.txt", "state.ply", "trace.json", "notes.txt"}) write(dir / f, "old");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag"})");  // a run's
   {
     OutputDir out(dir, kOutputs);
     write(out.staged("summary.txt"), "new");
@@ -69,6 +70,22 @@ TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
   EXPECT_EQ(read(dir / "summary.txt"), "new");
   for (const char* f : {"state.ply", "trace.json", "frames"}) EXPECT_FALSE(fs::exists(dir / f)) << f;
   EXPECT_EQ(read(dir / "notes.txt"), "old") << "not an output: kept";
+  fs::remove_all(dir);
+}
+
+TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
+  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-foreign";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "frames");
+  write(dir / "frames" / "mine.png", "mine");
+  write(dir / "trace.json", "mine");
+  {
+    OutputDir out(dir, kOutputs);
+    write(out.staged("manifest.json"), "new");
+    out.commit();
+  }
+  EXPECT_EQ(read(dir / "frames" / "mine.png"), "mine");
+  EXPECT_EQ(read(dir / "trace.json"), "mine");
   fs::remove_all(dir);
 }
 
