@@ -56,6 +56,7 @@ const std::vector<BadInput>& cases() {
       {"steps_zero", "run --steps 0", "--steps"},
       {"steps_negative", "run --steps -5", "--steps"},
       {"steps_letters", "run --steps abc", "--steps"},
+      {"steps_over_memory", "run --pipeline cpu --grid 4x4 --steps 2147483647", "2147483647 steps keep 192 GiB of step records"},
       {"warmup_negative", "run --warmup-ms -1", "--warmup-ms must be between 0"},
       {"warmup_nan", "run --warmup-ms nan", "--warmup-ms must be between 0"},
       {"warmup_letters", "run --warmup-ms abc", "--warmup-ms"},
