@@ -92,6 +92,16 @@ void apply_param_flags(const RunArgs& a, Params& p) {
     throw BadInput("--warmup-ms must be between 0 and 3600000 (an hour)");
 }
 
+}  // namespace
+
+void check_run_flags(const RunArgs& a) {
+  Scene scratch;
+  apply_model_flags(a, scratch.model);
+  apply_param_flags(a, scratch.params);
+}
+
+namespace {
+
 // Refuses a run whose host memory does not fit before anything is allocated.
 void check_fits(const RunInput& in, bool compare, const ModelSize& size) {
   const std::string why = host_memory_shortfall(size, *in.entry, in.integ, in.options,

@@ -29,6 +29,9 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag);
 // Reads the experiment or scene, applies the flags and builds the model; bad input
 // (unknown names, bad sizes or numbers, a model too large for memory) throws
 // std::invalid_argument with one line saying what is wrong.
+// The flags' own values (sizes, dt, steps, ...), checked with no experiment read and no GL
+// context made: `view` checks them before it opens its window.
+void check_run_flags(const RunArgs& a);
 // `run`'s output folder is checked first, before the model is built; `view` writes none.
 enum class Output { folder, none };
 RunInput read_run_input(const RunArgs& a, Output output = Output::folder);

@@ -17,6 +17,7 @@ int view_command(const ViewArgs& a) {
     if (a.seconds && !(*a.seconds > 0 && *a.seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
     if (a.max_frames && *a.max_frames < 1) throw std::invalid_argument("--max-frames must be at least 1");
     const std::vector<int> size = parse_size(a.size, 2, "--size");
+    check_run_flags(a.run);
     if (size[0] > 16384 || size[1] > 16384) throw std::invalid_argument("--size: at most 16384x16384");
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;

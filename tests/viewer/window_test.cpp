@@ -200,19 +200,26 @@ TEST_F(View, RefusesBadInputWithOneLine) {
   }
 }
 
-TEST(ViewWithoutDisplay, SaysSoInOneLineAndExits2) {
+// With no display: stderr of `deformlab view ARGS`, which must exit 2 with one line.
+std::string view_without_display(const std::string& args) {
   const fs::path file = fs::temp_directory_path() / ("deformlab-nodisplay-" + std::to_string(::getpid()) + ".txt");
   const std::string cmd =
-      std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + DEFORMLAB_EXE + " view --grid 8x8 2>" + file.string();
+      std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + DEFORMLAB_EXE + " view " + args + " 2>" + file.string();
   const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << args;
   std::ifstream in(file);
   const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   fs::remove(file);
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  return err;
+}
+
+TEST(ViewWithoutDisplay, SaysSoInOneLineAndExits2) {
+  const std::string err = view_without_display("--grid 8x8");
   EXPECT_NE(err.find("view needs a display"), std::string::npos) << err;
   EXPECT_NE(err.find("run --frames"), std::string::npos) << err;
+  // A bad flag is named first, before any window is asked for.
+  EXPECT_NE(view_without_display("--grid 0x5").find("--grid '0x5'"), std::string::npos);
 }
 
 }  // namespace
