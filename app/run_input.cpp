@@ -159,7 +159,8 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   check_records_fit(in.x.scene.params);
   if (a.compare && *a.compare != "reference")
-    throw BadInput("--compare '" + *a.compare + "': the only pipeline to compare with is 'reference' (double precision)");
+    throw BadInput("--compare '" + *a.compare +
+                   "': the only pipeline to compare with is 'reference' (double precision)");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));

@@ -40,7 +40,10 @@ void run_cpu(const StepOptions& o) {
 }  // namespace
 
 void add_cpu_bench(CLI::App& app) {
-  add_step_bench(app, "cpu", "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 sizes; the paper ran explicit Euler: --integrator explicit-euler)", {64, 128, 256, 512},
+  add_step_bench(app, "cpu",
+                 "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 sizes; the paper ran explicit Euler: "
+                 "--integrator explicit-euler)",
+                 {64, 128, 256, 512},
                  5, 30, run_cpu, Device::cpu);
 }
 

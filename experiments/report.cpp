@@ -261,9 +261,9 @@ void write_table(Report& r, const Table& t) {
   const std::string svg = "plot-" + t.title + ".svg";
   std::erase_if(series, [](const plot::Series& s) { return s.x.empty(); });  // no cell measured: no legend entry
   const bool paper = std::any_of(series.begin(), series.end(), [](const plot::Series& s) { return s.dashed; });
-  plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes",
-               std::string("ms per step, each on its pipeline's step clock") + (paper ? " (dashed: paper, ms per frame)" : ""),
-               series);
+  const std::string y = std::string("ms per step, each on its pipeline's step clock") +
+                        (paper ? " (dashed: paper, ms per frame)" : "");
+  plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes", y, series);
   r.md << "\n![" << t.title << "](" << svg << ")\n\n";
   if (r.ceil.any() && r.sweep.time == "update") write_ceiling_table(r.md, t.columns, r.results, r.ceil);
 }

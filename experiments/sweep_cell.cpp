@@ -199,8 +199,7 @@ json measure(json r, Pipeline& pipe, const Model& m, const Sweep& s, const Pipel
   const ClockSummary clock = watch ? watch->stop() : ClockSummary{};
   const double d = pipe.max_displacement();
   // A report's stage tables show where a GPU pipeline's step goes; the CPU's passes are plain loops.
-  if (gpu)
-    if (json stages = stage_times(pipe, steps, s); !stages.empty()) r["stages"] = stages;
+  if (json stages = gpu ? stage_times(pipe, steps, s) : json::array(); !stages.empty()) r["stages"] = stages;
   r["status"] = "ok";
   r["median_ms"] = median(ms);
   r["min_ms"] = *std::min_element(ms.begin(), ms.end());

@@ -119,7 +119,9 @@ TEST(HybridProfile, SpansPerStage) {
       hand_off += s.name == span::hand_off;
       update += s.name == span::update;
       // Interop runs on a GPU's GL, whose timer queries time the update.
-      const char* clock = s.name == span::force ? "CUDA events" : s.name == span::update ? "GL timer queries (GL_TIMESTAMP)" : "host clock";
+      const char* clock = s.name == span::force    ? "CUDA events"
+                          : s.name == span::update ? "GL timer queries (GL_TIMESTAMP)"
+                                                   : "host clock";
       EXPECT_EQ(s.clock, clock) << s.name;
     }
     EXPECT_EQ(force, sampled * 2);  // midpoint: two force passes per step

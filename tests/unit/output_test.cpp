@@ -16,6 +16,13 @@ namespace {
 namespace fs = std::filesystem;
 
 void write(const fs::path& f, const std::string& text) { std::ofstream(f) << text; }
+// An empty folder of this name in the test's temporary folder.
+fs::path fresh(const char* name) {
+  const fs::path dir = fs::path(testing::TempDir()) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
 std::string read(const fs::path& f) {
   std::ostringstream os;
   os << std::ifstream(f).rdbuf();
@@ -25,8 +32,7 @@ std::string read(const fs::path& f) {
 const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames"};
 
 TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
-  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-stopped";
-  fs::remove_all(dir);
+  const fs::path dir = fresh("deformlab-commit-stopped");
   fs::create_directories(dir / "state.ply");  // an entry the new file cannot replace: the commit stops there
   write(dir / "state.ply" / "x", "in the way");
   write(dir / "manifest.json", "old");
@@ -54,8 +60,7 @@ TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
 }
 
 TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
-  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-stale";
-  fs::remove_all(dir);
+  const fs::path dir = fresh("deformlab-commit-stale");
   fs::create_directories(dir / "frames");
   write(dir / "frames" / "frame_1.png", "old");
   for (const char* f : {"summary.txt", "state.ply", "trace.json", "notes.txt"}) write(dir / f, "old");
@@ -74,8 +79,7 @@ TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
 }
 
 TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
-  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-commit-foreign";
-  fs::remove_all(dir);
+  const fs::path dir = fresh("deformlab-commit-foreign");
   fs::create_directories(dir / "frames");
   write(dir / "frames" / "mine.png", "mine");
   write(dir / "trace.json", "mine");
@@ -90,9 +94,7 @@ TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
 }
 
 TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
-  const fs::path dir = fs::path(testing::TempDir()) / "deformlab-folder-holds";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh("deformlab-folder-holds");
   EXPECT_EQ(folder_holds(dir), Holds::nothing);
   EXPECT_NO_THROW(require_holds_nothing_but(dir, Holds::run));
   write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu"})");
