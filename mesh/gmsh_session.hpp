@@ -2,6 +2,7 @@
 #pragma once
 #include <gmsh.h>
 
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -9,7 +10,8 @@
 
 namespace deformlab {
 
-// Gmsh for the length of one task; its errors become exceptions with Gmsh's message.
+// Gmsh for the length of one task; its errors become exceptions with Gmsh's message (a failed
+// allocation stays std::bad_alloc).
 class GmshSession {
  public:
   GmshSession() {
@@ -26,6 +28,8 @@ class GmshSession {
     try {
       f();
     } catch (const std::invalid_argument&) {
+      throw;
+    } catch (const std::bad_alloc&) {
       throw;
     } catch (...) {
       std::string error;

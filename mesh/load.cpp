@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "child_read.hpp"
 #include "gmsh_session.hpp"
 
 namespace deformlab {
@@ -162,15 +163,19 @@ Mesh read_gmsh_model(const std::string& what) {
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) bad(path, "no such file");
-  if (std::filesystem::file_size(path, ec) == 0) bad(path, "the file is empty");
-  if (std::filesystem::path(path).extension() != ".msh") return load_with_assimp(path, notes);
-  GmshSession gmsh;
-  Mesh m;
-  GmshSession::run("mesh file '" + path + "'", [&] {
-    gmsh::open(path);
-    m = read_gmsh_model("mesh file '" + path + "'");
-  });
-  return m;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (size == 0) bad(path, "the file is empty");
+  const std::string what = "mesh file '" + path + "'";
+  return read_in_child(what, child_read_memory_cap(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
+    if (std::filesystem::path(path).extension() != ".msh") return load_with_assimp(path, read_notes);
+    GmshSession gmsh;
+    Mesh m;
+    GmshSession::run(what, [&] {
+      gmsh::open(path);
+      m = read_gmsh_model(what);
+    });
+    return m;
+  }, notes);
 }
 
 Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to) {

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <nlohmann/json.hpp>
 
 #include "core/cpu_backend.hpp"
@@ -109,11 +110,11 @@ TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
   EXPECT_EQ(error("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "accepted");
 }
 
-// A Gmsh box meshed and written as .msh, read back: linear tetrahedra, the box's volume.
-TEST_F(MeshFile, GmshVolumesAreRead) {
-  const std::string msh = (dir_ / "box.msh").string();
+// A 0.3 x 0.2 x 0.1 m box meshed by Gmsh and written as .msh (binary where asked).
+void write_gmsh_box(const std::string& msh, bool binary) {
   gmsh::initialize(0, nullptr, false);
   gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("Mesh.Binary", binary);
   gmsh::model::add("box");
   gmsh::model::occ::addBox(0, 0, 0, 0.3, 0.2, 0.1);
   gmsh::model::occ::synchronize();
@@ -121,6 +122,12 @@ TEST_F(MeshFile, GmshVolumesAreRead) {
   gmsh::model::mesh::generate(3);
   gmsh::write(msh);
   gmsh::finalize();
+}
+
+// The box read back: linear tetrahedra, the box's volume.
+TEST_F(MeshFile, GmshVolumesAreRead) {
+  const std::string msh = (dir_ / "box.msh").string();
+  write_gmsh_box(msh, false);
   Mesh m = load(msh);
   ASSERT_TRUE(m.volume());
   EXPECT_TRUE(repair(m).empty());
@@ -129,6 +136,55 @@ TEST_F(MeshFile, GmshVolumesAreRead) {
   for (float w : model.inv_mass) mass += 1.0 / w;
   EXPECT_NEAR(mass, 1000.0 * 0.3 * 0.2 * 0.1, 1e-3);
   EXPECT_GT(std::count(model.kind.begin(), model.kind.end(), SpringKind::flexion), 0);
+}
+
+// Gmsh and assimp trust a file's counts: a damaged one could crash them or take all memory.
+// Each is read in a child process (mesh/child_read.hpp), so any damage ends in a mesh or one line.
+TEST_F(MeshFile, DamagedFilesEndInAMeshOrOneLine) {
+  const std::string msh = (dir_ / "box.msh").string();
+  write_gmsh_box(msh, true);
+  std::string bytes;
+  {
+    std::ifstream in(msh, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // MSH 4.1's binary $Nodes section opens with four 8-byte counts: blocks, nodes, least and
+  // largest tag. A node count 2^36 too large asks for terabytes.
+  std::string huge = bytes;
+  const std::size_t nodes = huge.find("$Nodes\n") + 7 + 8;
+  huge[nodes + 4] = char(huge[nodes + 4] | 0x10);
+  const std::string error = [&] {
+    try {
+      load(write("huge.msh", huge));
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("read");
+  }();
+#if defined(__SANITIZE_ADDRESS__)
+  EXPECT_EQ(error.rfind("mesh file '" + (dir_ / "huge.msh").string() + "': ", 0), 0u) << error;
+#else
+  EXPECT_EQ(error, "mesh file '" + (dir_ / "huge.msh").string() +
+                       "': reading it took more than the 2 GiB of memory allowed for a file of its size (damaged counts?)");
+#endif
+  // Cut short and overwritten at random (a fixed seed): each a mesh or std::invalid_argument.
+  std::mt19937 random(7);
+  int refused = 0;
+  for (int k = 0; k < 40; ++k) {
+    std::string damaged = bytes;
+    if (k % 2) {
+      damaged.resize(random() % damaged.size());
+    } else {
+      for (int b = 0; b < 4; ++b) damaged[random() % damaged.size()] = char(random());
+    }
+    try {
+      load(write("damaged.msh", damaged));
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("mesh file '", 0), 0u) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GE(refused, 20) << "every file cut short is refused";
 }
 
 TEST_F(MeshFile, TheBunnyIsClosedAndFillsWithTetrahedra) {

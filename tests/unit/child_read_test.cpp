@@ -1,0 +1,81 @@
+// Mesh files read in a child process (mesh/child_read.hpp): the mesh and notes come back
+// whole; a reader's error, a crash and a reader past its memory cap each become one
+// std::invalid_argument naming the file, and this process goes on.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+#include "mesh/child_read.hpp"
+
+namespace deformlab::test {
+namespace {
+
+std::string error_of(std::int64_t cap, const std::function<Mesh(std::vector<std::string>&)>& read) {
+  std::vector<std::string> notes;
+  try {
+    read_in_child("mesh file 'f'", cap, read, notes);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "read";
+}
+
+TEST(ChildRead, TheMeshAndNotesComeBackWhole) {
+  Mesh sent;
+  for (int k = 0; k < 100000; ++k) sent.position.push_back({float(k), 0.5f * float(k), -float(k)});
+  for (int k = 0; k < 3000; ++k) sent.triangle.push_back({k, k + 1, k + 7});
+  for (int k = 0; k < 5000; ++k) sent.tetrahedron.push_back({k, k + 2, k + 3, 99999 - k});
+  std::vector<std::string> notes{"a note from before"};
+  const Mesh got = read_in_child("mesh file 'f'", std::int64_t(1) << 30, [&](std::vector<std::string>& n) {
+    n.push_back("left out 2 points and 0 lines");
+    n.push_back(std::string(70000, 'x'));  // longer than a pipe's buffer
+    return sent;
+  }, notes);
+  EXPECT_EQ(got.position, sent.position);
+  EXPECT_EQ(got.triangle, sent.triangle);
+  EXPECT_EQ(got.tetrahedron, sent.tetrahedron);
+  EXPECT_EQ(notes, (std::vector<std::string>{"a note from before", "left out 2 points and 0 lines", std::string(70000, 'x')}));
+}
+
+TEST(ChildRead, AReadersErrorComesBackAsItIs) {
+  EXPECT_EQ(error_of(std::int64_t(1) << 30, [](std::vector<std::string>&) -> Mesh {
+              throw std::invalid_argument("mesh file 'f': no triangles");
+            }),
+            "mesh file 'f': no triangles");
+}
+
+TEST(ChildRead, ACrashIsNamedWithItsSignal) {
+  EXPECT_EQ(error_of(std::int64_t(1) << 30, [](std::vector<std::string>&) -> Mesh {
+              std::raise(SIGSEGV);
+              return {};
+            }),
+            std::string("mesh file 'f': its reader stopped on signal ") + std::to_string(SIGSEGV) + " (" +
+                strsignal(SIGSEGV) + "): a damaged file?");
+}
+
+TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
+  const std::int64_t cap = std::int64_t(256) << 20;
+  const std::string error = error_of(cap, [&](std::vector<std::string>&) -> Mesh {
+    Mesh m;
+    m.position.resize(std::size_t(2 * cap / sizeof(Vec3f)));  // twice the cap by itself
+    return m;
+  });
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's allocator ends the process where operator new would throw.
+  EXPECT_EQ(error.rfind("mesh file 'f': its reader stopped", 0), 0u) << error;
+#else
+  EXPECT_EQ(error, "mesh file 'f': reading it took more than the 0.25 GiB of memory allowed for a file of its size "
+                   "(damaged counts?)");
+#endif
+  EXPECT_EQ(error_of(cap, [](std::vector<std::string>&) {
+              Mesh m;
+              m.position.resize(std::size_t(1) << 20);  // 12 MiB: well under the cap
+              return m;
+            }),
+            "read");
+}
+
+}  // namespace
+}  // namespace deformlab::test
