@@ -237,7 +237,7 @@ int run_command(const RunArgs& a) {
     // 1. Everything is read and checked before anything is written (bad input: exit 2).
     const RunInput in = read_run_input(a);
     // 2. Run, writing into a staging folder that is committed only on success.
-    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames"});
+    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames/"});
     const auto t0 = std::chrono::steady_clock::now();
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -65,9 +65,33 @@ void reclaim_temporaries(const fs::path& dir) {
   }
 }
 
+namespace {
+
+// The output's name without the '/' that marks a folder.
+fs::path entry_name(const std::string& output) {
+  return output.ends_with('/') ? output.substr(0, output.size() - 1) : output;
+}
+
+}  // namespace
+
+void OutputDir::require_replaceable(const std::vector<std::string>& names) const {
+  std::error_code ec;
+  for (const auto& name : names) {
+    const fs::path target = dir_ / entry_name(name);
+    const auto status = fs::symlink_status(target, ec);
+    if (!fs::exists(status) || fs::is_directory(status) == name.ends_with('/')) continue;
+    throw std::invalid_argument("output folder '" + dir_.string() + "' holds " +
+                                (fs::is_directory(status) ? "a folder" : "a file") + " named '" +
+                                entry_name(name).string() + "' where this output writes " +
+                                (name.ends_with('/') ? "a folder" : "a file") + ": move it or give another --out");
+  }
+}
+
 OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs) : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
+  require_replaceable(outputs_);
+  require_replaceable({"manifest.json"});
   created_ = !fs::exists(dir_, ec);
   held_output_ = folder_holds(dir_) == Holds::run;
   fs::create_directories(dir_, ec);
@@ -85,9 +109,13 @@ OutputDir::~OutputDir() {
 }
 
 void OutputDir::commit() {
+  std::vector<std::string> staged;
+  for (const auto& e : fs::directory_iterator(staging_))
+    staged.push_back(e.path().filename().string() + (e.is_directory() ? "/" : ""));
+  require_replaceable(staged);  // an entry put in the way during the run: nothing is changed yet
   fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
   for (const auto& name : outputs_)
-    if (held_output_ && !fs::exists(staging_ / name)) fs::remove_all(dir_ / name);
+    if (held_output_ && !fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
   for (const auto& e : fs::directory_iterator(staging_)) {
     if (e.path().filename() == "manifest.json") continue;
     const fs::path target = dir_ / e.path().filename();

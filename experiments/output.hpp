@@ -36,10 +36,12 @@ void reclaim_temporaries(const std::filesystem::path& dir);
 
 class OutputDir {
  public:
-  // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder).
-  // `outputs`: every name such an output may hold besides manifest.json; where the folder
-  // held one (its manifest says so), commit() removes those the new one does not write, so that
-  // the folder holds one output's files. Files in a folder that held none are left alone.
+  // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder, or
+  // holds a file where an output has a folder or the other way round).
+  // `outputs`: every name such an output may hold besides manifest.json, a folder's ending in
+  // '/'; where the folder held one (its manifest says so), commit() removes those the new one
+  // does not write, so that the folder holds one output's files. Files in a folder that held
+  // none are left alone.
   OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs);
   // Removes the staging folder, and the output folder too if this object created it and
   // nothing was committed.
@@ -51,11 +53,15 @@ class OutputDir {
   std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
   // Moves every staged entry into the output folder (replacing entries of the same name):
   // the old manifest.json is removed first, then the old output's files the new one lacks, and
-  // the new manifest is moved in last.
+  // the new manifest is moved in last. Throws std::invalid_argument, with the folder as it was,
+  // where an entry of the other kind (file or folder) has appeared in the way since.
   void commit();
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
+  // Throws std::invalid_argument where one of `names` (a folder's ending in '/') is in the
+  // output folder as the other kind of entry.
+  void require_replaceable(const std::vector<std::string>& names) const;
   std::filesystem::path dir_, staging_;
   std::vector<std::string> outputs_;
   bool held_output_ = false;  // the folder held such an output when this object was made

@@ -1,4 +1,5 @@
-// Run outputs (experiments/output.hpp): a commit stopped between its renames leaves a folder
+// Run outputs (experiments/output.hpp): an entry of the other kind in an output's place is
+// refused before anything changes; a commit stopped between its renames leaves a folder
 // without a manifest, the mark of an incomplete run, and the next run's commit completes it;
 // a commit leaves none of the old output's files that the new one lacks; a folder holds one
 // run or one experiment.
@@ -29,23 +30,53 @@ std::string read(const fs::path& f) {
   return os.str();
 }
 
-const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames"};
+const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames/"};
 
-TEST(OutputDir, CommitStoppedBetweenRenamesLeavesNoManifest) {
-  const fs::path dir = fresh("deformlab-commit-stopped");
-  fs::create_directories(dir / "state.ply");  // an entry the new file cannot replace: the commit stops there
+TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
+  const fs::path dir = fresh("deformlab-commit-in-the-way");
+  fs::create_directories(dir / "state.ply");  // a folder where the output writes a file
   write(dir / "state.ply" / "x", "in the way");
   write(dir / "manifest.json", "old");
-  write(dir / "summary.txt", "old");
-  {
+  const std::string error = "output folder '" + dir.string() +
+                            "' holds a folder named 'state.ply' where this output writes a file: move it or give another --out";
+  try {
     OutputDir out(dir, kOutputs);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(e.what(), error);
+  }
+  fs::remove_all(dir / "state.ply");
+  write(dir / "frames", "a file where the output has a folder");
+  EXPECT_THROW(OutputDir(dir, kOutputs), std::invalid_argument);
+  fs::remove(dir / "frames");
+  {
+    OutputDir out(dir, kOutputs);  // the entry appears during the run
     write(out.staged("summary.txt"), "new");
     write(out.staged("state.ply"), "new");
     write(out.staged("manifest.json"), "new");
-    EXPECT_THROW(out.commit(), fs::filesystem_error);
-    EXPECT_FALSE(fs::exists(dir / "manifest.json")) << "an incomplete folder must have no manifest";
+    fs::create_directories(dir / "state.ply");
+    try {
+      out.commit();
+      ADD_FAILURE() << "committed";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(e.what(), error);
+    }
   }
-  fs::remove_all(dir / "state.ply");
+  EXPECT_EQ(read(dir / "manifest.json"), "old") << "the folder as it was";
+  EXPECT_FALSE(fs::exists(dir / "summary.txt"));
+  fs::remove_all(dir);
+}
+
+TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesIt) {
+  const fs::path dir = fresh("deformlab-commit-stopped");
+  // What a commit stopped after its first rename leaves: the old manifest removed, one new
+  // output in place, the rest still in its staging folder (whose process is gone).
+  write(dir / "summary.txt", "new");
+  write(dir / "state.ply", "old");
+  fs::create_directories(dir / ".staging-999999999");
+  write(dir / ".staging-999999999" / "state.ply", "new");
+  write(dir / ".staging-999999999" / "manifest.json", "new");
+  EXPECT_EQ(folder_holds(dir), Holds::nothing) << "an incomplete folder has no manifest";
   {
     OutputDir out(dir, kOutputs);
     write(out.staged("summary.txt"), "newer");
