@@ -12,6 +12,7 @@
 #include "core/run.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
+#include "progress.hpp"
 #include "run_input.hpp"
 #if DEFORMLAB_GL_RENDER
 #include "gl/render.hpp"
@@ -59,6 +60,8 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   opt.until_converged = in.until_converged;
   opt.integrator = in.integ;
   opt.profiler = &profiler;
+  ProgressLine progress(in.params.max_steps, in.params.dt, in.until_converged ? in.params.threshold : 0.0);
+  if (progress.shown()) opt.progress = std::ref(progress);
 #if DEFORMLAB_GL_RENDER
   std::optional<gl::FrameWriter> frames;
   if (a.frames) {

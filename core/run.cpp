@@ -179,6 +179,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     }
     times.after_step();
     if (opt.after_step) opt.after_step(step);
+    if (opt.progress) opt.progress(step, r.last_displacement);
     if (stop) {
       r.converged = true;
       break;

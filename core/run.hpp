@@ -61,6 +61,9 @@ struct RunOptions {
   // Called after every step (e.g. to write frames); may be empty. When set, each check waits
   // for its step; else a pipeline that can step back has it read while the next step runs.
   std::function<void(int step)> after_step;
+  // Called after every step with the largest displacement last checked (m; 0 before the
+  // first check), without waiting for the device: for a progress line. May be empty.
+  std::function<void(int step, double displacement)> progress;
   // When set: the pipeline's own stage spans, "step" on the step clock and "reductions" on
   // the host clock.
   Profiler* profiler = nullptr;

@@ -65,6 +65,26 @@ int mesh_nodes(const std::string& out) {
 
 // `deformlab mesh` writes the mesh an experiment's model generates; a scene naming that file in
 // place of "generate" runs on it, with the nodes the command counted.
+// On a terminal (here the pseudo-terminal `script` gives it) a run keeps a progress line,
+// written over itself twice a second and cleared before the summary; in a log it writes none.
+TEST_F(Cli, RunKeepsAProgressLineOnATerminalOnly) {
+  const fs::path log = dir_ / "terminal.txt";
+  // About 1 s on one core: a line after 0.5 s.
+  const std::string run_args = " run --pipeline cpu --grid 128x128 --steps 600 --check-every 600 --out ";
+  const std::string cmd = "script -qec '" + std::string(DEFORMLAB_EXE) + run_args + (dir_ / "a").string() + "' " +
+                          log.string() + " >/dev/null 2>&1 </dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const std::string seen = slurp(log);
+  const std::string line = "\r\x1b[K  step ";
+  EXPECT_NE(seen.find(line), std::string::npos) << seen;
+  EXPECT_NE(seen.find(" of 600 ("), std::string::npos) << seen;
+  EXPECT_NE(seen.find(" on the host clock, about "), std::string::npos) << seen;
+  EXPECT_NE(seen.find("\r\x1b[Kdeformlab run: "), std::string::npos) << "cleared before the summary:\n" << seen;
+  const Result r = run(" run --pipeline cpu --steps 20 --out " + (dir_ / "b").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "") << "no progress line in a log";
+}
+
 TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   write("x.json", R"({"scene": {"model": {"type": "mesh", "pins": "none",
                                          "generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 1}}},
