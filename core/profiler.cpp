@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "write_error.hpp"
+
 #if DEFORMLAB_NVTX
 #include <nvtx3/nvToolsExt.h>
 #endif
@@ -77,7 +79,7 @@ std::vector<Profiler::Stage> Profiler::summary() const {
 
 void Profiler::stream_csv(const std::string& path, bool keep) {
   stream_ = std::make_unique<std::ofstream>(path);
-  if (!*stream_) throw std::runtime_error("cannot write " + path);
+  if (!*stream_) throw write_error(path);
   *stream_ << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
   stream_path_ = path;
   keep_ = keep;
@@ -88,15 +90,16 @@ void Profiler::end_stream() {
   stream_->close();
   const bool ok = bool(*stream_);
   stream_.reset();
-  if (!ok) throw std::runtime_error("writing " + stream_path_ + " failed");
+  if (!ok) throw write_error(stream_path_);
 }
 
 void Profiler::write_csv(const std::string& path) const {
   std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write " + path);
+  if (!f) throw write_error(path);
   f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
   for (const Span& s : spans_) write_row(f, s);
-  if (!f) throw std::runtime_error("writing " + path + " failed");
+  f.close();
+  if (!f) throw write_error(path);
 }
 
 void Profiler::write_trace(const std::string& path) const {
@@ -121,9 +124,10 @@ void Profiler::write_trace(const std::string& path) const {
                       {"args", {{"step", s.step}}}});
   }
   std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write " + path);
+  if (!f) throw write_error(path);
   f << nlohmann::json{{"traceEvents", events}, {"displayTimeUnit", "ms"}}.dump() << "\n";
-  if (!f) throw std::runtime_error("writing " + path + " failed");
+  f.close();
+  if (!f) throw write_error(path);
 }
 
 #if DEFORMLAB_NVTX

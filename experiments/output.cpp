@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "build_info.hpp"
+#include "core/write_error.hpp"
 
 namespace deformlab {
 
@@ -125,11 +126,24 @@ void OutputDir::commit() {
   if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
 }
 
+namespace {
+
+bool ply_grid_faces(const Model& m) { return m.topology == Topology::cloth_grid && m.nx > 1 && m.ny > 1; }
+std::int64_t ply_face_count(const Model& m) {
+  return ply_grid_faces(m) ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : std::int64_t(m.triangle.size() / 3);
+}
+
+}  // namespace
+
+std::int64_t ply_bytes(const Model& m) {
+  return 512 + 24 * std::int64_t(m.node_count()) + 13 * ply_face_count(m);  // the header is under 512 bytes
+}
+
 void write_ply(const fs::path& file, const Model& m, const State& s) {
   std::ofstream out(file, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write " + file.string());
-  const bool grid_faces = m.topology == Topology::cloth_grid && m.nx > 1 && m.ny > 1;
-  const std::int64_t nf = grid_faces ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : std::int64_t(m.triangle.size() / 3);
+  if (!out) throw write_error(file.string());
+  const bool grid_faces = ply_grid_faces(m);
+  const std::int64_t nf = ply_face_count(m);
   out << "ply\nformat binary_little_endian 1.0\n"
       << "comment deformlab state at t = " << s.t << " s; positions in m, velocities in m/s\n"
       << "element vertex " << s.x.size() << "\n"
@@ -174,12 +188,13 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
   for (std::size_t t = 0; !grid_faces && t + 2 < m.triangle.size(); t += 3)
     face({m.file_index(m.triangle[t]), m.file_index(m.triangle[t + 1]), m.file_index(m.triangle[t + 2])});
   flush(true);
-  if (!out) throw std::runtime_error("failed writing " + file.string());
+  out.close();  // the stream's own buffer goes out here: a full disk shows now or never
+  if (!out) throw write_error(file.string());
 }
 
 void write_timings_csv(const fs::path& file, const RunResult& r) {
   std::ofstream out(file);
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  if (!out) throw write_error(file.string());
   out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";
   out.precision(9);
   for (const auto& rec : r.records) {
@@ -187,14 +202,16 @@ void write_timings_csv(const fs::path& file, const RunResult& r) {
     if (rec.max_displacement == rec.max_displacement) out << rec.max_displacement;
     out << '\n';
   }
-  if (!out) throw std::runtime_error("failed writing " + file.string());
+  out.close();
+  if (!out) throw write_error(file.string());
 }
 
 void write_json(const fs::path& file, const nlohmann::json& j) {
   std::ofstream out(file);
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  if (!out) throw write_error(file.string());
   out << j.dump(2) << '\n';
-  if (!out) throw std::runtime_error("failed writing " + file.string());
+  out.close();
+  if (!out) throw write_error(file.string());
 }
 
 nlohmann::json machine_info() {

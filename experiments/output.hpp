@@ -71,6 +71,8 @@ class OutputDir {
 // Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their
 // triangles (two per quad) so mesh tools show the surface. numpy reads it via plyfile.
 void write_ply(const std::filesystem::path& file, const Model& m, const State& s);
+// The bytes write_ply writes for this model, at most.
+std::int64_t ply_bytes(const Model& m);
 // step,t_s,step_ms (on the run's step clock),queue_ms (host clock around step()),
 // max_displacement_m (empty where the step was not checked).
 void write_timings_csv(const std::filesystem::path& file, const RunResult& r);

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/write_error.hpp"
+
 namespace deformlab::plot {
 
 namespace {
@@ -38,7 +40,8 @@ void save(const std::filesystem::path& file, const std::string& body, double hei
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << height
       << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << body << "</svg>\n";
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  out.close();
+  if (!out) throw write_error(file.string());
 }
 
 std::string frame(const std::string& title, const std::string& xlabel, const std::string& ylabel) {

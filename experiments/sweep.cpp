@@ -10,6 +10,7 @@
 #include "core/run.hpp"
 #include "core/scene.hpp"
 #include "core/state.hpp"
+#include "core/write_error.hpp"
 #include "mesh/scene_model.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
@@ -211,7 +212,7 @@ void write_atomically(const fs::path& file, const std::string& text) {
   std::ofstream out(tmp);
   out << text;
   out.close();
-  if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  if (!out) throw write_error(tmp.string());
   fs::rename(tmp, file);
 }
 

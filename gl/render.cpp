@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "core/write_error.hpp"
 #include "gl_pipeline.hpp"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -410,7 +411,7 @@ std::vector<std::uint8_t> Renderer::pixels() {
 void Renderer::write_png(const std::filesystem::path& file) {
   const auto px = pixels();
   if (!stbi_write_png(file.string().c_str(), impl_->o.width, impl_->o.height, 4, px.data(), impl_->o.width * 4))
-    throw std::runtime_error("cannot write " + file.string());
+    throw write_error(file.string());
 }
 
 std::vector<double> Renderer::take_draw_ms() { return impl_->timer.take(); }

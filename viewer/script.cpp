@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/json_file.hpp"
+#include "core/write_error.hpp"
 
 namespace deformlab::viewer {
 namespace {
@@ -98,9 +99,10 @@ void write_script(const std::string& path, const std::vector<Event>& events) {
   {
     std::ofstream out(tmp);
     out << nlohmann::json{{"events", list}}.dump(1) << "\n";
-    if (!out) throw std::runtime_error("cannot write " + path);
+    out.close();
+    if (!out) throw write_error(path);
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write " + path);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw write_error(path);
 }
 
 }  // namespace deformlab::viewer

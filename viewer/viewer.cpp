@@ -12,6 +12,7 @@
 
 #include "core/one_line.hpp"
 #include "core/run.hpp"
+#include "core/write_error.hpp"
 #include "gl/context.hpp"
 #include "experiments/pipelines.hpp"
 #include "orbit.hpp"
@@ -391,8 +392,9 @@ class Viewer {
     summary_["largest_move_m"] = moved;  // of any node since the viewer opened
     std::ofstream out(o_.summary);
     out << summary_.dump(1) << "\n";
+    out.close();
     if (out) return 0;
-    std::cerr << "deformlab: error: cannot write " << o_.summary << "\n";
+    std::cerr << "deformlab: error: " << write_error(o_.summary).what() << "\n";
     return 1;
   }
 

@@ -85,6 +85,24 @@ TEST_F(Cli, RunKeepsAProgressLineOnATerminalOnly) {
   EXPECT_EQ(r.err, "") << "no progress line in a log";
 }
 
+// A run whose files would not fit on its output folder's file system (here a 300 kB tmpfs,
+// mounted in a mount namespace of its own) is refused before it runs.
+TEST_F(Cli, RunThatWouldFillTheDiskIsRefused) {
+  const fs::path small = dir_ / "small";
+  fs::create_directories(small);
+  const fs::path err = dir_ / "err.txt";
+  const std::string cmd = "unshare -m sh -c 'mount -t tmpfs -o size=300k tmpfs " + small.string() + " || exit 99; " +
+                          DEFORMLAB_EXE + " run --pipeline cpu --steps 2000 --out " + (small / "r").string() + "' 2>" +
+                          err.string();
+  const int status = std::system(cmd.c_str());
+  if (WEXITSTATUS(status) == 99 || (WEXITSTATUS(status) == 1 && slurp(err).find("unshare") != std::string::npos))
+    GTEST_SKIP() << "no tmpfs in a mount namespace here: " << slurp(err);
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(slurp(err), "deformlab: error: output folder '" + (small / "r").string() +
+                            "': this run writes about 1.1 MiB (2000 steps' timings and spans, state.ply) and its "
+                            "file system has 0.293 MiB free: free some or give another --out\n");
+}
+
 TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   write("x.json", R"({"scene": {"model": {"type": "mesh", "pins": "none",
                                          "generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 1}}},

@@ -124,6 +124,15 @@ TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
   fs::remove_all(dir);
 }
 
+TEST(OutputFiles, AFailedWriteSaysWhy) {
+  try {
+    write_json("/dev/full", nlohmann::json{{"a", 1}});
+    ADD_FAILURE() << "written";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cannot write /dev/full: No space left on device");
+  }
+}
+
 TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
   const fs::path dir = fresh("deformlab-folder-holds");
   EXPECT_EQ(folder_holds(dir), Holds::nothing);
