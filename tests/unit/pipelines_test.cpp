@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <fstream>
 #include <numeric>
 #include <string>
 #include <thread>
@@ -174,7 +175,21 @@ TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {
   EXPECT_EQ(host_memory_shortfall(small, cpu, Integrator::semi_implicit_euler, {}), "");
   const auto limit = host_memory_limit();
   ASSERT_TRUE(limit.has_value());
+  // The tightest limit: never above what /proc/meminfo has available (read again here, so
+  // within what other processes took or gave back in between), and that figure itself where
+  // no cgroup limit is tighter.
+  std::int64_t available = 0;
+  {
+    std::ifstream meminfo("/proc/meminfo");
+    std::string key, unit;
+    for (std::int64_t kb; meminfo >> key >> kb >> unit;)
+      if (key == "MemAvailable:") available = kb * 1024;
+  }
+  ASSERT_GT(available, 0);
   EXPECT_GT(limit->bytes, 0);
+  EXPECT_LE(limit->bytes, available + available / 20);
+  if (limit->name == "MemAvailable (/proc/meminfo)") EXPECT_NEAR(double(limit->bytes), double(available), 0.05 * double(available));
+  else EXPECT_EQ(limit->name.rfind("the cgroup's memory limit (", 0), 0u) << limit->name;
   // Semi-implicit Euler on cpu: slots (x, v), one acceleration, next (x, v), x_prev: 6 vec3 of floats.
   EXPECT_EQ(cpu.footprint(small, Integrator::semi_implicit_euler, {}).host, small.nodes * 6 * 12);
   // 2^30 nodes by backward Euler in doubles: terabytes, more than any machine here has.

@@ -17,10 +17,10 @@ namespace {
 
 using viewer::Session;
 
-Session cloth_session(const std::string& pipeline, int side = 12) {
+Session cloth_session(const std::string& pipeline, int side = 12, Integrator i = Integrator::semi_implicit_euler) {
   Model m = small_cloth(side, side);
   m.damping = {0.02f, 0.02f, 0.01f};
-  return Session({std::move(m), small_params(), pipelines().find(pipeline), Integrator::semi_implicit_euler, {}});
+  return Session({std::move(m), small_params(), pipelines().find(pipeline), i, {}});
 }
 
 TEST(ViewerSession, ReplacedPipelineContinuesTheTrajectory) {
@@ -41,6 +41,36 @@ TEST(ViewerSession, ReplacedPipelineContinuesTheTrajectory) {
   EXPECT_TRUE(bitwise_equal(s.pipeline().state(), plain.pipeline().state()));
   EXPECT_EQ(s.steps(), 25);
   EXPECT_NEAR(s.time(), 10 * 0.001 + 15 * 0.002, 1e-8);
+}
+
+TEST(ViewerSession, VerletKeepsItsPreviousPositionsOnlyAtItsOwnStep) {
+  const Integrator verlet = Integrator::verlet;
+  Session s = cloth_session("cpu", 12, verlet), plain = cloth_session("cpu", 12, verlet);
+  s.step(10);
+  plain.step(10);
+  // The same rule and step: the previous positions go along and the run goes on as if uninterrupted.
+  ASSERT_EQ(s.replace(*pipelines().find("omp"), verlet, {}, s.params().dt), "");
+  s.step(10);
+  plain.step(10);
+  EXPECT_TRUE(bitwise_equal(s.pipeline().state(), plain.pipeline().state()));
+  // Another step: they belong to the old one, so Verlet starts again from (x, v).
+  const State at = s.pipeline().state();
+  ASSERT_FALSE(at.x_prev.empty());
+  const float dt = 2 * s.params().dt;
+  ASSERT_EQ(s.replace(*pipelines().find("cpu"), verlet, {}, dt), "");
+  s.step(10);
+  Params p = small_params();
+  p.dt = dt;
+  auto again = [&](bool keep_previous) {
+    auto pipe = pipelines().find("cpu")->make({s.model(), p, verlet, {}});
+    State from = at;
+    if (!keep_previous) from.x_prev.clear();
+    pipe->set_state(from);
+    for (int k = 0; k < 10; ++k) pipe->step();
+    return pipe->state();
+  };
+  EXPECT_TRUE(bitwise_equal(s.pipeline().state(), again(false)));
+  EXPECT_FALSE(bitwise_equal(s.pipeline().state(), again(true))) << "the old step's previous positions would differ";
 }
 
 TEST(ViewerSession, EveryAvailablePipelineTakesTheStateExactly) {
