@@ -298,11 +298,16 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
       ->check(CLI::PositiveNumber);
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
-  c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none: skip)");
+  c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none or 0: skip)")
+      ->expected(0, CLI::detail::expected_max_vector_size)
+      ->check(CLI::Range(0, 1 << 16));
   c->add_option("--steps-per-launch", o->steps_per_launch, "cuda-temporal's steps per launch to compare")
       ->check(CLI::Range(1, 8));
   c->add_option("--temporal-tiles", o->temporal_tiles, "cuda-temporal's tiles WxH to compare (default: its own)");
-  c->callback([o] { run_cuda(*o); });
+  c->callback([o] {
+    std::erase(o->temporal_sizes, 0);  // "--temporal-sizes" alone gives {0}
+    run_cuda(*o);
+  });
 }
 
 }  // namespace deformlab::bench
