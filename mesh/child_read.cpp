@@ -1,6 +1,7 @@
 #include "child_read.hpp"
 
 #include <fcntl.h>
+#include <omp.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -91,6 +92,9 @@ std::string gib(std::int64_t bytes) {
 [[noreturn]] void child(int fd, const std::string& what, std::int64_t cap,
                         const std::function<Mesh(std::vector<std::string>&)>& read) {
   if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDERR_FILENO);
+  // The parent's OpenMP threads are not in the child, and libgomp would wait for them in a
+  // parallel region of more than one thread: a reader that runs one runs it on this thread.
+  omp_set_num_threads(1);
   if (FILE* f = std::fopen("/proc/self/status", "r")) {
     char line[256];
     long kb = -1;

@@ -39,6 +39,25 @@ TEST(ChildRead, TheMeshAndNotesComeBackWhole) {
   EXPECT_EQ(notes, (std::vector<std::string>{"a note from before", "left out 2 points and 0 lines", std::string(70000, 'x')}));
 }
 
+// After this process's OpenMP threads have run, a reader's parallel region runs in the child
+// (on its one thread) instead of waiting for threads the child does not have.
+TEST(ChildRead, AReaderMayRunOpenMpAfterThisProcessHas) {
+  int here = 0;
+#pragma omp parallel num_threads(2) reduction(+ : here)
+  here += 1;
+  ASSERT_EQ(here, 2);
+  std::vector<std::string> notes;
+  const Mesh m = read_in_child("mesh file 'f'", std::int64_t(1) << 30, [](std::vector<std::string>&) {
+    int there = 0;
+#pragma omp parallel reduction(+ : there)
+    there += 1;
+    Mesh out;
+    out.position.resize(std::size_t(there));
+    return out;
+  }, notes);
+  EXPECT_EQ(m.position.size(), 1u);
+}
+
 TEST(ChildRead, AReadersErrorComesBackAsItIs) {
   EXPECT_EQ(error_of(std::int64_t(1) << 30, [](std::vector<std::string>&) -> Mesh {
               throw std::invalid_argument("mesh file 'f': no triangles");
