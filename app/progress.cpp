@@ -25,7 +25,7 @@ std::string seconds(double s) {
 
 ProgressLine::ProgressLine(int max_steps, double dt, double threshold)
     : max_steps_(max_steps), dt_(dt), threshold_(threshold), shown_(::isatty(STDERR_FILENO) == 1),
-      start_(std::chrono::steady_clock::now()), next_(start_ + kInterval) {}
+      start_(std::chrono::steady_clock::now()), next_(start_) {}
 
 ProgressLine::~ProgressLine() {
   if (written_) std::cerr << kClearLine << std::flush;

@@ -1,7 +1,7 @@
 // The progress line `deformlab run` keeps on a terminal: steps done, simulated time, the host
 // clock's elapsed time and an estimate of what is left; on a convergence run, the largest
-// displacement last checked against the threshold. Written over itself twice a second, and
-// only where stderr is a terminal, so logs and pipes get none.
+// displacement last checked against the threshold. Written at the first step and then over
+// itself twice a second, and only where stderr is a terminal, so logs and pipes get none.
 #pragma once
 #include <chrono>
 #include <string>

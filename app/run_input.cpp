@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <sstream>
+#include <utility>
 
 #include "core/memory.hpp"
 #include "experiments/output.hpp"
@@ -122,19 +124,10 @@ void check_records_fit(const Params& p) {
                    limit->name + " leaves " + gib(limit->bytes) + " (at most half of it for them): run fewer steps");
 }
 
-// Refuses a run whose files would not fit in the free space of its output folder's file
-// system. Bytes a step measured (cpu, a 128² cloth, 3000 steps): timings.csv 48, spans.csv 108;
-// with --trace spans.csv 229 and trace.json 629; a frame of 1024² pixels 132-146 kB.
-void check_disk_fits(const RunArgs& a, const RunInput& in) {
-  namespace fs = std::filesystem;
-  auto size = [](std::int64_t bytes) {
-    if (bytes >= std::int64_t(1) << 30) return gib(bytes);
-    std::ostringstream os;
-    os.precision(3);
-    os << double(bytes) / double(1 << 20) << " MiB";
-    return os.str();
-  };
-  const std::int64_t steps = in.params.max_steps;
+// Bytes a run writes for `steps` steps, and what they are. Measured (cpu, a 128² cloth, 3000
+// steps): timings.csv 48 a step, spans.csv 108; with --trace spans.csv 229 and trace.json 629;
+// a frame of 1024² pixels 132-146 kB, counted at 100 kB so that the sum stays under the need.
+std::pair<std::int64_t, std::string> output_bytes(const RunArgs& a, const RunInput& in, std::int64_t steps) {
   std::int64_t need = steps * (a.trace ? 56 + 240 + 640 : 56 + 112);
   std::string what = std::to_string(steps) + " steps' timings" + (a.trace ? ", spans and trace" : " and spans");
   if (!a.no_state) {
@@ -145,15 +138,29 @@ void check_disk_fits(const RunArgs& a, const RunInput& in) {
     need += (steps / *a.frames + 1) * 100'000;
     what += ", frames at 100 kB";
   }
+  return {need, what};
+}
+
+// Refuses a run whose files would not fit in the free space of its output folder's file
+// system; a convergence run, which may stop at min_steps, only where those would not, with a
+// note where all its steps would not.
+void check_disk_fits(const RunArgs& a, const RunInput& in) {
+  namespace fs = std::filesystem;
   std::error_code ec;
   fs::path at = fs::absolute(in.out, ec);
   while (!fs::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
   struct statvfs v{};
   if (::statvfs(at.c_str(), &v) != 0) return;
   const std::int64_t free = std::int64_t(v.f_bavail) * std::int64_t(v.f_frsize);
+  const Params& p = in.params;
+  const auto [need, what] = output_bytes(a, in, in.until_converged ? std::min(p.min_steps, p.max_steps) : p.max_steps);
+  const std::string folder = "output folder '" + in.out.string() + "'";
   if (need > free)
-    throw BadInput("output folder '" + in.out.string() + "': this run writes about " + size(need) + " (" + what +
-                   ") and its file system has " + size(free) + " free: free some or give another --out");
+    throw BadInput(folder + ": this run writes " + (in.until_converged ? "at least " : "about ") + bytes_text(need) +
+                   " (" + what + ") and its file system has " + bytes_text(free) + " free: free some or give another --out");
+  if (const auto [most, _] = output_bytes(a, in, p.max_steps); in.until_converged && most > free)
+    std::cerr << "deformlab: note: " << folder << " has " << bytes_text(free) << " free; this run writes "
+              << bytes_text(most) << " if it runs all " << p.max_steps << " steps without converging\n";
 }
 
 }  // namespace

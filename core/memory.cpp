@@ -74,6 +74,21 @@ std::optional<MemoryLimit> host_memory_limit() {
   return best;
 }
 
+std::string bytes_text(std::int64_t bytes) {
+  if (bytes >= std::int64_t(1) << 30) return gib(bytes);
+  std::ostringstream os;
+  os.precision(3);
+  os << double(bytes) / double(1 << 20) << " MiB";
+  return os.str();
+}
+
+std::string about_nodes(double n) {
+  std::ostringstream os;
+  os.precision(3);
+  os << "about " << n << " nodes";
+  return os.str();
+}
+
 std::string gib(std::int64_t bytes) {
   std::ostringstream os;
   os.precision(3);

@@ -41,5 +41,9 @@ std::optional<MemoryLimit> host_memory_limit();
 
 // "12.3 GiB"
 std::string gib(std::int64_t bytes);
+// "0.293 MiB" under 1 GiB, else as gib().
+std::string bytes_text(std::int64_t bytes);
+// "about 9.85e+08 nodes": a node count estimated before a mesh is made.
+std::string about_nodes(double n);
 
 }  // namespace deformlab

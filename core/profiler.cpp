@@ -62,7 +62,10 @@ void Profiler::add(Span s) {
     it->per_step.push_back(s.ms);
     it->last_step = s.step;
   }
-  if (stream_) write_row(*stream_, s);
+  if (stream_) {
+    write_row(*stream_, s);
+    if (!*stream_ && !stream_error_) stream_error_ = errno;  // the first failed write's reason, if any
+  }
   if (keep_) spans_.push_back(std::move(s));
 }
 
@@ -87,15 +90,17 @@ void Profiler::stream_csv(const std::string& path, bool keep) {
 
 void Profiler::end_stream() {
   if (!stream_) return;
+  errno = 0;
   stream_->close();
   const bool ok = bool(*stream_);
   stream_.reset();
-  if (!ok) throw write_error(stream_path_);
+  if (!ok) throw write_error(stream_path_, stream_error_ ? stream_error_ : errno);
 }
 
 void Profiler::write_csv(const std::string& path) const {
   std::ofstream f(path);
   if (!f) throw write_error(path);
+  errno = 0;
   f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
   for (const Span& s : spans_) write_row(f, s);
   f.close();
@@ -125,6 +130,7 @@ void Profiler::write_trace(const std::string& path) const {
   }
   std::ofstream f(path);
   if (!f) throw write_error(path);
+  errno = 0;
   f << nlohmann::json{{"traceEvents", events}, {"displayTimeUnit", "ms"}}.dump() << "\n";
   f.close();
   if (!f) throw write_error(path);

@@ -94,6 +94,7 @@ class Profiler {
   std::vector<Totals> totals_;
   std::unique_ptr<std::ofstream> stream_;
   std::string stream_path_;
+  int stream_error_ = 0;  // errno at the stream's first failed write
   bool keep_ = true;
   int step_ = 0;
   int every_ = 1;

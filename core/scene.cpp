@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -10,6 +9,7 @@
 #include <stdexcept>
 
 #include "json_file.hpp"
+#include "memory.hpp"
 
 namespace deformlab {
 
@@ -196,11 +196,8 @@ MeshShape shape(const json& j, const std::string& where) {
     s.threads = integer(j["threads"], where + ".threads", 1);
     if (s.threads > 1024) bad(where + ".threads", "expected at most 1024 threads");
   }
-  if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30)) {
-    std::ostringstream about;
-    about << std::setprecision(3) << n;
-    bad(where + ".cell_size", "would make about " + about.str() + " nodes, over the limit of 2^30");
-  }
+  if (const double n = estimated_nodes(s); n > double(std::int64_t(1) << 30))
+    bad(where + ".cell_size", "would make " + about_nodes(n) + ", over the limit of 2^30");
   return s;
 }
 

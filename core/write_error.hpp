@@ -1,5 +1,7 @@
 // A file that could not be opened or written, with the system's reason where it left one
-// (errno after the failed call: "No space left on device", "Permission denied").
+// ("No space left on device", "Permission denied"): `error` is errno as the failed call left
+// it, 0 for none. A writer clears errno once its file is open, so that what it reads at the end
+// comes from that file's writes.
 #pragma once
 #include <cerrno>
 #include <cstring>
@@ -8,9 +10,8 @@
 
 namespace deformlab {
 
-inline std::runtime_error write_error(const std::string& path) {
-  const int e = errno;
-  return std::runtime_error("cannot write " + path + (e ? std::string(": ") + std::strerror(e) : std::string()));
+inline std::runtime_error write_error(const std::string& path, int error = errno) {
+  return std::runtime_error("cannot write " + path + (error ? std::string(": ") + std::strerror(error) : std::string()));
 }
 
 }  // namespace deformlab

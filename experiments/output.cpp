@@ -113,7 +113,14 @@ void OutputDir::commit() {
   std::vector<std::string> staged;
   for (const auto& e : fs::directory_iterator(staging_))
     staged.push_back(e.path().filename().string() + (e.is_directory() ? "/" : ""));
-  require_replaceable(staged);  // an entry put in the way during the run: nothing is changed yet
+  try {
+    require_replaceable(staged);  // an entry put in the way during the run: nothing is changed yet
+  } catch (const std::invalid_argument& e) {
+    // Not bad input: the run is done, so its outputs stay, under a name the next run leaves alone.
+    const fs::path kept = dir_ / ("unsaved-run-" + std::to_string(::getpid()));
+    fs::rename(staging_, kept);
+    throw std::runtime_error(std::string(e.what()) + "; this run's outputs are in '" + kept.string() + "'");
+  }
   fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
   for (const auto& name : outputs_)
     if (held_output_ && !fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
@@ -142,6 +149,7 @@ std::int64_t ply_bytes(const Model& m) {
 void write_ply(const fs::path& file, const Model& m, const State& s) {
   std::ofstream out(file, std::ios::binary);
   if (!out) throw write_error(file.string());
+  errno = 0;
   const bool grid_faces = ply_grid_faces(m);
   const std::int64_t nf = ply_face_count(m);
   out << "ply\nformat binary_little_endian 1.0\n"
@@ -195,6 +203,7 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
 void write_timings_csv(const fs::path& file, const RunResult& r) {
   std::ofstream out(file);
   if (!out) throw write_error(file.string());
+  errno = 0;
   out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";
   out.precision(9);
   for (const auto& rec : r.records) {
@@ -209,6 +218,7 @@ void write_timings_csv(const fs::path& file, const RunResult& r) {
 void write_json(const fs::path& file, const nlohmann::json& j) {
   std::ofstream out(file);
   if (!out) throw write_error(file.string());
+  errno = 0;
   out << j.dump(2) << '\n';
   out.close();
   if (!out) throw write_error(file.string());

@@ -53,8 +53,9 @@ class OutputDir {
   std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
   // Moves every staged entry into the output folder (replacing entries of the same name):
   // the old manifest.json is removed first, then the old output's files the new one lacks, and
-  // the new manifest is moved in last. Throws std::invalid_argument, with the folder as it was,
-  // where an entry of the other kind (file or folder) has appeared in the way since.
+  // the new manifest is moved in last. Where an entry of the other kind (file or folder) has
+  // appeared in the way since, throws std::runtime_error with the folder as it was and the
+  // outputs moved to `dir`/unsaved-run-<pid>.
   void commit();
   const std::filesystem::path& dir() const { return dir_; }
 

@@ -36,6 +36,7 @@ std::string num(double v) {
 
 // The SVG of `body`, kW wide and `height` high (kH, or more where labels hang below the plot).
 void save(const std::filesystem::path& file, const std::string& body, double height = kH) {
+  errno = 0;
   std::ofstream out(file);
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << height
       << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"

@@ -1,6 +1,7 @@
 #include "child_read.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <omp.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -13,6 +14,9 @@
 #include <new>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
+
+#include "core/memory.hpp"
 
 namespace deformlab {
 
@@ -82,16 +86,13 @@ struct Reader {
   }
 };
 
-std::string gib(std::int64_t bytes) {
-  char s[32];
-  std::snprintf(s, sizeof s, "%.3g GiB", double(bytes) / double(1 << 30));
-  return s;
-}
-
-// In the child: caps its data segment at what it has plus `cap`, reads, writes the message.
-[[noreturn]] void child(int fd, const std::string& what, std::int64_t cap,
-                        const std::function<Mesh(std::vector<std::string>&)>& read) {
+// In the child: caps its data segment at what it has plus the limit and its CPU time, reads,
+// writes the message and ends; nothing it throws or returns gets back into the caller's code.
+[[noreturn]] void child(int fd, const std::string& what, ChildLimits limits,
+                        const std::function<Mesh(std::vector<std::string>&)>& read) noexcept {
+#if !defined(__SANITIZE_ADDRESS__)  // a sanitizer's report on the reader's code stays visible
   if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDERR_FILENO);
+#endif
   // The parent's OpenMP threads are not in the child, and libgomp would wait for them in a
   // parallel region of more than one thread: a reader that runs one runs it on this thread.
   omp_set_num_threads(1);
@@ -100,10 +101,14 @@ std::string gib(std::int64_t bytes) {
     long kb = -1;
     while (kb < 0 && std::fgets(line, sizeof line, f)) std::sscanf(line, "VmData: %ld kB", &kb);
     std::fclose(f);
-    if (rlimit limit{}; kb >= 0 && ::getrlimit(RLIMIT_DATA, &limit) == 0) {
-      limit.rlim_cur = std::min(limit.rlim_max, rlim_t(kb) * 1024 + rlim_t(cap));
-      ::setrlimit(RLIMIT_DATA, &limit);
+    if (rlimit data{}; kb >= 0 && ::getrlimit(RLIMIT_DATA, &data) == 0) {
+      data.rlim_cur = std::min(data.rlim_cur, rlim_t(kb) * 1024 + rlim_t(limits.memory));
+      ::setrlimit(RLIMIT_DATA, &data);
     }
+  }
+  if (rlimit cpu{}; ::getrlimit(RLIMIT_CPU, &cpu) == 0) {  // a child's CPU time starts at 0
+    cpu.rlim_cur = std::min(cpu.rlim_cur, rlim_t(limits.cpu_s));
+    ::setrlimit(RLIMIT_CPU, &cpu);
   }
   static bool out_of_memory = false;  // the libraries turn std::bad_alloc into their own errors
   std::set_new_handler([] {
@@ -114,7 +119,7 @@ std::string gib(std::int64_t bytes) {
   Writer out{fd};
   auto fail = [&](const std::string& error) {
     out.bytes(&kError, 1);
-    out.text(out_of_memory ? what + ": reading it took more than the " + gib(cap) +
+    out.text(out_of_memory ? what + ": reading it took more than the " + gib(limits.memory) +
                                  " of memory allowed for a file of its size (damaged counts?)"
                            : error);
   };
@@ -132,20 +137,43 @@ std::string gib(std::int64_t bytes) {
     for (const auto& n : notes) out.text(n);
   } catch (const std::exception& e) {
     fail(e.what());
+  } catch (...) {
+    fail(what + ": its reader failed with an exception of unknown type");
   }
   ::_exit(out.ok ? 0 : 1);
 }
 
+// The parent's end of the pipe and the child: closed and reaped however the parent leaves.
+struct ChildEnd {
+  int fd;
+  pid_t pid;
+  int status = 0;
+  bool reaped = false;
+  int wait() {
+    ::close(std::exchange(fd, -1));
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    reaped = true;
+    return status;
+  }
+  ~ChildEnd() {
+    if (reaped) return;
+    ::kill(pid, SIGKILL);
+    wait();
+  }
+};
+
 }  // namespace
 
-std::int64_t child_read_memory_cap(std::int64_t file_bytes) {
-  return std::max<std::int64_t>(std::int64_t(2) << 30, 64 * file_bytes);
+ChildLimits child_read_limits(std::int64_t file_bytes) {
+  return {std::max<std::int64_t>(std::int64_t(2) << 30, 64 * file_bytes), int(60 + 2 * (file_bytes >> 20))};
 }
 
-Mesh read_in_child(const std::string& what, std::int64_t memory_cap,
+Mesh read_in_child(const std::string& what, ChildLimits limits,
                    const std::function<Mesh(std::vector<std::string>&)>& read, std::vector<std::string>& notes) {
   int fd[2];
   if (::pipe2(fd, O_CLOEXEC) != 0) return read(notes);
+  std::fflush(nullptr);  // else the child's copy of an unwritten stdout buffer could be written twice
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fd[0]);
@@ -154,9 +182,10 @@ Mesh read_in_child(const std::string& what, std::int64_t memory_cap,
   }
   if (pid == 0) {
     ::close(fd[0]);
-    child(fd[1], what, memory_cap, read);
+    child(fd[1], what, limits, read);
   }
   ::close(fd[1]);
+  ChildEnd end{fd[0], pid};
   Reader in{fd[0]};
   char kind = 0;
   in.bytes(&kind, 1);
@@ -173,10 +202,7 @@ Mesh read_in_child(const std::string& what, std::int64_t memory_cap,
   } else if (in.ok && kind == kError) {
     error = in.text();
   }
-  ::close(fd[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
+  const int status = end.wait();
   if (!in.ok || (kind != kMesh && kind != kError)) {
     if (WIFSIGNALED(status))
       throw std::invalid_argument(what + ": its reader stopped on signal " + std::to_string(WTERMSIG(status)) + " (" +

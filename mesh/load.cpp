@@ -166,7 +166,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   const auto size = std::filesystem::file_size(path, ec);
   if (size == 0) bad(path, "the file is empty");
   const std::string what = "mesh file '" + path + "'";
-  return read_in_child(what, child_read_memory_cap(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
+  return read_in_child(what, child_read_limits(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
     if (std::filesystem::path(path).extension() != ".msh") return load_with_assimp(path, read_notes);
     GmshSession gmsh;
     Mesh m;

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -74,8 +73,7 @@ void check_fill_size(const Mesh& surface, float cell_size) {
   }
   const double n = estimated_filled_nodes(std::abs(volume), cell_size);
   std::ostringstream about;
-  about << "filling with tetrahedra of cell_size " << cell_size << " m would make about " << std::setprecision(3) << n
-        << " nodes";
+  about << "filling with tetrahedra of cell_size " << cell_size << " m would make " << about_nodes(n);
   if (n > double(std::int64_t(1) << 30)) throw std::invalid_argument(about.str() + ", over the limit of 2^30");
   try {
     check_memory(std::int64_t(n), std::int64_t(n * 16), std::int64_t(n * 6.6));
@@ -125,8 +123,8 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
   try {
     check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("generated " + std::string(to_string(shape.kind)) + " of about " +
-                                std::to_string(std::int64_t(n)) + " nodes: " + e.what());
+    throw std::invalid_argument("generated " + std::string(to_string(shape.kind)) + " of " + about_nodes(n) + ": " +
+                                e.what());
   }
   return generate_shape(shape, save_to);
 }

@@ -97,6 +97,7 @@ void write_script(const std::string& path, const std::vector<Event>& events) {
   for (const Event& e : events) list.push_back(to_json(e));
   const std::string tmp = path + ".tmp";
   {
+    errno = 0;
     std::ofstream out(tmp);
     out << nlohmann::json{{"events", list}}.dump(1) << "\n";
     out.close();

@@ -390,6 +390,7 @@ class Viewer {
     summary_["integrator"] = info(s_.integrator()).name;
     summary_["dt"] = s_.params().dt;
     summary_["largest_move_m"] = moved;  // of any node since the viewer opened
+    errno = 0;
     std::ofstream out(o_.summary);
     out << summary_.dump(1) << "\n";
     out.close();

@@ -1,5 +1,5 @@
 // Mesh files read in a child process (mesh/child_read.hpp): the mesh and notes come back
-// whole; a reader's error, a crash and a reader past its memory cap each become one
+// whole; a reader's error, a crash and a reader past its memory or CPU cap each become one
 // std::invalid_argument naming the file, and this process goes on.
 #include <gtest/gtest.h>
 
@@ -12,10 +12,12 @@
 namespace deformlab::test {
 namespace {
 
-std::string error_of(std::int64_t cap, const std::function<Mesh(std::vector<std::string>&)>& read) {
+const ChildLimits kEnough{std::int64_t(1) << 30, 60};
+
+std::string error_of(ChildLimits limits, const std::function<Mesh(std::vector<std::string>&)>& read) {
   std::vector<std::string> notes;
   try {
-    read_in_child("mesh file 'f'", cap, read, notes);
+    read_in_child("mesh file 'f'", limits, read, notes);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
@@ -28,7 +30,7 @@ TEST(ChildRead, TheMeshAndNotesComeBackWhole) {
   for (int k = 0; k < 3000; ++k) sent.triangle.push_back({k, k + 1, k + 7});
   for (int k = 0; k < 5000; ++k) sent.tetrahedron.push_back({k, k + 2, k + 3, 99999 - k});
   std::vector<std::string> notes{"a note from before"};
-  const Mesh got = read_in_child("mesh file 'f'", std::int64_t(1) << 30, [&](std::vector<std::string>& n) {
+  const Mesh got = read_in_child("mesh file 'f'", kEnough, [&](std::vector<std::string>& n) {
     n.push_back("left out 2 points and 0 lines");
     n.push_back(std::string(70000, 'x'));  // longer than a pipe's buffer
     return sent;
@@ -47,7 +49,7 @@ TEST(ChildRead, AReaderMayRunOpenMpAfterThisProcessHas) {
   here += 1;
   ASSERT_EQ(here, 2);
   std::vector<std::string> notes;
-  const Mesh m = read_in_child("mesh file 'f'", std::int64_t(1) << 30, [](std::vector<std::string>&) {
+  const Mesh m = read_in_child("mesh file 'f'", kEnough, [](std::vector<std::string>&) {
     int there = 0;
 #pragma omp parallel reduction(+ : there)
     there += 1;
@@ -59,14 +61,14 @@ TEST(ChildRead, AReaderMayRunOpenMpAfterThisProcessHas) {
 }
 
 TEST(ChildRead, AReadersErrorComesBackAsItIs) {
-  EXPECT_EQ(error_of(std::int64_t(1) << 30, [](std::vector<std::string>&) -> Mesh {
+  EXPECT_EQ(error_of(kEnough, [](std::vector<std::string>&) -> Mesh {
               throw std::invalid_argument("mesh file 'f': no triangles");
             }),
             "mesh file 'f': no triangles");
 }
 
 TEST(ChildRead, ACrashIsNamedWithItsSignal) {
-  EXPECT_EQ(error_of(std::int64_t(1) << 30, [](std::vector<std::string>&) -> Mesh {
+  EXPECT_EQ(error_of(kEnough, [](std::vector<std::string>&) -> Mesh {
               std::raise(SIGSEGV);
               return {};
             }),
@@ -76,7 +78,7 @@ TEST(ChildRead, ACrashIsNamedWithItsSignal) {
 
 TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
   const std::int64_t cap = std::int64_t(256) << 20;
-  const std::string error = error_of(cap, [&](std::vector<std::string>&) -> Mesh {
+  const std::string error = error_of({cap, 60}, [&](std::vector<std::string>&) -> Mesh {
     Mesh m;
     m.position.resize(std::size_t(2 * cap / sizeof(Vec3f)));  // twice the cap by itself
     return m;
@@ -88,12 +90,26 @@ TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
   EXPECT_EQ(error, "mesh file 'f': reading it took more than the 0.25 GiB of memory allowed for a file of its size "
                    "(damaged counts?)");
 #endif
-  EXPECT_EQ(error_of(cap, [](std::vector<std::string>&) {
+  EXPECT_EQ(error_of({cap, 60}, [](std::vector<std::string>&) {
               Mesh m;
               m.position.resize(std::size_t(1) << 20);  // 12 MiB: well under the cap
               return m;
             }),
             "read");
+}
+
+TEST(ChildRead, AReaderPastItsCpuTimeIsStopped) {
+  const std::string error = error_of({std::int64_t(1) << 30, 1}, [](std::vector<std::string>&) -> Mesh {
+    volatile unsigned spins = 0;
+    for (;;) spins = spins + 1u;
+  });
+  EXPECT_EQ(error, std::string("mesh file 'f': its reader stopped on signal ") + std::to_string(SIGXCPU) + " (" +
+                       strsignal(SIGXCPU) + "): a damaged file?");
+}
+
+TEST(ChildRead, AnExceptionOfAnyTypeEndsInTheChild) {
+  EXPECT_EQ(error_of(kEnough, [](std::vector<std::string>&) -> Mesh { throw 42; }),
+            "mesh file 'f': its reader failed with an exception of unknown type");
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
 // Run outputs (experiments/output.hpp): an entry of the other kind in an output's place is
-// refused before anything changes; a commit stopped between its renames leaves a folder
-// without a manifest, the mark of an incomplete run, and the next run's commit completes it;
-// a commit leaves none of the old output's files that the new one lacks; a folder holds one
-// run or one experiment.
+// refused before anything changes (after the run, with its outputs kept); a commit stopped
+// between its renames leaves a folder without a manifest, the mark of an incomplete run, and
+// the next run's commit completes it; a commit leaves none of the old output's files that the
+// new one lacks; a folder holds one run or one experiment; a failed write says why.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -55,12 +56,14 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
     write(out.staged("state.ply"), "new");
     write(out.staged("manifest.json"), "new");
     fs::create_directories(dir / "state.ply");
+    const fs::path kept = dir / ("unsaved-run-" + std::to_string(::getpid()));
     try {
       out.commit();
       ADD_FAILURE() << "committed";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_EQ(e.what(), error);
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(e.what(), error + "; this run's outputs are in '" + kept.string() + "'");
     }
+    EXPECT_EQ(read(kept / "state.ply"), "new") << "the run's outputs kept";
   }
   EXPECT_EQ(read(dir / "manifest.json"), "old") << "the folder as it was";
   EXPECT_FALSE(fs::exists(dir / "summary.txt"));
