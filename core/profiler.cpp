@@ -98,13 +98,10 @@ void Profiler::end_stream() {
 }
 
 void Profiler::write_csv(const std::string& path) const {
-  std::ofstream f(path);
-  if (!f) throw write_error(path);
-  errno = 0;
-  f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
-  for (const Span& s : spans_) write_row(f, s);
-  f.close();
-  if (!f) throw write_error(path);
+  write_file(path, [&](std::ostream& f) {
+    f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
+    for (const Span& s : spans_) write_row(f, s);
+  });
 }
 
 void Profiler::write_trace(const std::string& path) const {
@@ -128,12 +125,9 @@ void Profiler::write_trace(const std::string& path) const {
                       {"dur", s.ms * 1000.0},
                       {"args", {{"step", s.step}}}});
   }
-  std::ofstream f(path);
-  if (!f) throw write_error(path);
-  errno = 0;
-  f << nlohmann::json{{"traceEvents", events}, {"displayTimeUnit", "ms"}}.dump() << "\n";
-  f.close();
-  if (!f) throw write_error(path);
+  write_file(path, [&](std::ostream& f) {
+    f << nlohmann::json{{"traceEvents", events}, {"displayTimeUnit", "ms"}}.dump() << "\n";
+  });
 }
 
 #if DEFORMLAB_NVTX

@@ -1,17 +1,20 @@
-// A file that could not be opened or written, with the system's reason where it left one
-// ("No space left on device", "Permission denied"): `error` is errno as the failed call left
-// it, 0 for none. A writer clears errno once its file is open, so that what it reads at the end
-// comes from that file's writes.
+// Files written whole, and the error for one that could not be opened or written, with the
+// system's reason where it left one ("No space left on device", "Permission denied").
 #pragma once
 #include <cerrno>
-#include <cstring>
+#include <functional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 
 namespace deformlab {
 
-inline std::runtime_error write_error(const std::string& path, int error = errno) {
-  return std::runtime_error("cannot write " + path + (error ? std::string(": ") + std::strerror(error) : std::string()));
-}
+// `error`: errno as the failed call left it, 0 for none.
+std::runtime_error write_error(const std::string& path, int error = errno);
+
+// Opens `path` (truncating it), writes it through `body` and closes it; throws write_error
+// where opening, a write or the close failed. errno is cleared once the file is open, so that
+// the reason given is one of this file's writes.
+void write_file(const std::string& path, const std::function<void(std::ostream&)>& body, bool binary = false);
 
 }  // namespace deformlab

@@ -140,16 +140,7 @@ std::int64_t ply_face_count(const Model& m) {
   return ply_grid_faces(m) ? 2 * std::int64_t(m.nx - 1) * (m.ny - 1) : std::int64_t(m.triangle.size() / 3);
 }
 
-}  // namespace
-
-std::int64_t ply_bytes(const Model& m) {
-  return 512 + 24 * std::int64_t(m.node_count()) + 13 * ply_face_count(m);  // the header is under 512 bytes
-}
-
-void write_ply(const fs::path& file, const Model& m, const State& s) {
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw write_error(file.string());
-  errno = 0;
+void put_ply(std::ostream& out, const Model& m, const State& s) {
   const bool grid_faces = ply_grid_faces(m);
   const std::int64_t nf = ply_face_count(m);
   out << "ply\nformat binary_little_endian 1.0\n"
@@ -196,32 +187,32 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
   for (std::size_t t = 0; !grid_faces && t + 2 < m.triangle.size(); t += 3)
     face({m.file_index(m.triangle[t]), m.file_index(m.triangle[t + 1]), m.file_index(m.triangle[t + 2])});
   flush(true);
-  out.close();  // the stream's own buffer goes out here: a full disk shows now or never
-  if (!out) throw write_error(file.string());
+}
+
+}  // namespace
+
+std::int64_t ply_bytes(const Model& m) {
+  return 512 + 24 * std::int64_t(m.node_count()) + 13 * ply_face_count(m);  // the header is under 512 bytes
+}
+
+void write_ply(const fs::path& file, const Model& m, const State& s) {
+  write_file(file.string(), [&](std::ostream& out) { put_ply(out, m, s); }, true);
 }
 
 void write_timings_csv(const fs::path& file, const RunResult& r) {
-  std::ofstream out(file);
-  if (!out) throw write_error(file.string());
-  errno = 0;
-  out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";
-  out.precision(9);
-  for (const auto& rec : r.records) {
-    out << rec.step << ',' << rec.t << ',' << rec.ms << ',' << rec.queue_ms << ',';
-    if (rec.max_displacement == rec.max_displacement) out << rec.max_displacement;
-    out << '\n';
-  }
-  out.close();
-  if (!out) throw write_error(file.string());
+  write_file(file.string(), [&](std::ostream& out) {
+    out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";
+    out.precision(9);
+    for (const auto& rec : r.records) {
+      out << rec.step << ',' << rec.t << ',' << rec.ms << ',' << rec.queue_ms << ',';
+      if (rec.max_displacement == rec.max_displacement) out << rec.max_displacement;
+      out << '\n';
+    }
+  });
 }
 
 void write_json(const fs::path& file, const nlohmann::json& j) {
-  std::ofstream out(file);
-  if (!out) throw write_error(file.string());
-  errno = 0;
-  out << j.dump(2) << '\n';
-  out.close();
-  if (!out) throw write_error(file.string());
+  write_file(file.string(), [&](std::ostream& out) { out << j.dump(2) << '\n'; });
 }
 
 nlohmann::json machine_info() {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,13 +35,11 @@ std::string num(double v) {
 
 // The SVG of `body`, kW wide and `height` high (kH, or more where labels hang below the plot).
 void save(const std::filesystem::path& file, const std::string& body, double height = kH) {
-  errno = 0;
-  std::ofstream out(file);
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << height
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-      << body << "</svg>\n";
-  out.close();
-  if (!out) throw write_error(file.string());
+  write_file(file.string(), [&](std::ostream& out) {
+    out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kW << "\" height=\"" << height
+        << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+        << body << "</svg>\n";
+  });
 }
 
 std::string frame(const std::string& title, const std::string& xlabel, const std::string& ylabel) {

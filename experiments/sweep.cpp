@@ -209,11 +209,7 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 
 void write_atomically(const fs::path& file, const std::string& text) {
   const fs::path tmp = temporary(file);
-  errno = 0;
-  std::ofstream out(tmp);
-  out << text;
-  out.close();
-  if (!out) throw write_error(tmp.string());
+  write_file(tmp.string(), [&](std::ostream& out) { out << text; });
   fs::rename(tmp, file);
 }
 

@@ -26,22 +26,12 @@ namespace {
 // notes; or 'E' and the error's text. A string is its length (8 bytes) and its bytes.
 constexpr char kMesh = 'M', kError = 'E';
 
-bool write_all(int fd, const void* data, std::size_t size) {
-  auto p = static_cast<const char*>(data);
+// All `size` bytes through `fd` by read(2) or write(2) (`call`), again after a signal or a
+// short count; false at the end of the pipe or on an error.
+template <class Byte, class Call>
+bool whole(Call call, int fd, Byte* p, std::size_t size) {
   while (size) {
-    const ssize_t n = ::write(fd, p, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    size -= std::size_t(n);
-  }
-  return true;
-}
-
-bool read_all(int fd, void* data, std::size_t size) {
-  auto p = static_cast<char*>(data);
-  while (size) {
-    const ssize_t n = ::read(fd, p, size);
+    const ssize_t n = call(fd, p, size);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
     p += n;
@@ -53,7 +43,7 @@ bool read_all(int fd, void* data, std::size_t size) {
 struct Writer {
   int fd;
   bool ok = true;
-  void bytes(const void* data, std::size_t size) { ok = ok && write_all(fd, data, size); }
+  void bytes(const void* data, std::size_t size) { ok = ok && whole(::write, fd, static_cast<const char*>(data), size); }
   void count(std::uint64_t n) { bytes(&n, sizeof n); }
   void text(std::string_view s) {
     count(s.size());
@@ -68,7 +58,7 @@ struct Writer {
 struct Reader {
   int fd;
   bool ok = true;
-  void bytes(void* data, std::size_t size) { ok = ok && read_all(fd, data, size); }
+  void bytes(void* data, std::size_t size) { ok = ok && whole(::read, fd, static_cast<char*>(data), size); }
   std::uint64_t count() {
     std::uint64_t n = 0;
     bytes(&n, sizeof n);

@@ -1,6 +1,5 @@
 #include "script.hpp"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -96,13 +95,7 @@ void write_script(const std::string& path, const std::vector<Event>& events) {
   nlohmann::json list = nlohmann::json::array();
   for (const Event& e : events) list.push_back(to_json(e));
   const std::string tmp = path + ".tmp";
-  {
-    errno = 0;
-    std::ofstream out(tmp);
-    out << nlohmann::json{{"events", list}}.dump(1) << "\n";
-    out.close();
-    if (!out) throw write_error(path);
-  }
+  write_file(tmp, [&](std::ostream& out) { out << nlohmann::json{{"events", list}}.dump(1) << "\n"; });
   if (std::rename(tmp.c_str(), path.c_str()) != 0) throw write_error(path);
 }
 

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -390,13 +389,13 @@ class Viewer {
     summary_["integrator"] = info(s_.integrator()).name;
     summary_["dt"] = s_.params().dt;
     summary_["largest_move_m"] = moved;  // of any node since the viewer opened
-    errno = 0;
-    std::ofstream out(o_.summary);
-    out << summary_.dump(1) << "\n";
-    out.close();
-    if (out) return 0;
-    std::cerr << "deformlab: error: " << write_error(o_.summary).what() << "\n";
-    return 1;
+    try {
+      write_file(o_.summary, [&](std::ostream& out) { out << summary_.dump(1) << "\n"; });
+    } catch (const std::runtime_error& e) {
+      std::cerr << "deformlab: error: " << e.what() << "\n";
+      return 1;
+    }
+    return 0;
   }
 
   enum class Mouse { none, drag_node, orbit, pan };
