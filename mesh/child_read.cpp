@@ -100,18 +100,19 @@ struct Reader {
     cpu.rlim_cur = std::min(cpu.rlim_cur, rlim_t(limits.cpu_s));
     ::setrlimit(RLIMIT_CPU, &cpu);
   }
-  static bool out_of_memory = false;  // the libraries turn std::bad_alloc into their own errors
+  // An allocation past the cap: named as such when it ends the read, and beside the reader's
+  // own error when a library caught it and failed later in its own words.
+  static bool out_of_memory = false;
   std::set_new_handler([] {
     out_of_memory = true;
     std::set_new_handler(nullptr);
     throw std::bad_alloc();
   });
+  const std::string cap = "the " + gib(limits.memory) + " of memory allowed for a file of its size";
   Writer out{fd};
   auto fail = [&](const std::string& error) {
     out.bytes(&kError, 1);
-    out.text(out_of_memory ? what + ": reading it took more than the " + gib(limits.memory) +
-                                 " of memory allowed for a file of its size (damaged counts?)"
-                           : error);
+    out.text(out_of_memory ? error + " (an allocation past " + cap + " failed before: damaged counts?)" : error);
   };
   try {
     std::vector<std::string> notes;
@@ -125,6 +126,9 @@ struct Reader {
     out.array(m.tetrahedron);
     out.count(notes.size());
     for (const auto& n : notes) out.text(n);
+  } catch (const std::bad_alloc&) {
+    out.bytes(&kError, 1);
+    out.text(what + ": reading it took more than " + cap + " (damaged counts?)");
   } catch (const std::exception& e) {
     fail(e.what());
   } catch (...) {

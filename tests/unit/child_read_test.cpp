@@ -103,6 +103,24 @@ TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
             "read");
 }
 
+// A library that catches the failed allocation and fails later in its own words: its error,
+// with the cap beside it.
+TEST(ChildRead, AnErrorAfterACaughtAllocationPastTheCapNamesBoth) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's allocator ends the process where operator new would throw";
+#endif
+  const std::int64_t cap = std::int64_t(256) << 20;
+  EXPECT_EQ(error_of({cap, 60}, [&](std::vector<std::string>&) -> Mesh {
+              try {
+                std::vector<char> big(std::size_t(2 * cap));
+              } catch (const std::bad_alloc&) {
+              }
+              throw std::invalid_argument("mesh file 'f': no nodes");
+            }),
+            "mesh file 'f': no nodes (an allocation past the 0.25 GiB of memory allowed for a file of its size "
+            "failed before: damaged counts?)");
+}
+
 TEST(ChildRead, AReaderPastItsCpuTimeIsStopped) {
   const std::string error = error_of({std::int64_t(1) << 30, 1}, [](std::vector<std::string>&) -> Mesh {
     volatile unsigned spins = 0;
