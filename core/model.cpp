@@ -206,7 +206,8 @@ std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSel
       for (std::size_t k = 0; k < list.size(); ++k) try {
           for (int v : select_nodes(m, list[k])) out.push_back(v);
         } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument("pins[" + std::to_string(k) + "]: " + e.what());
+          const std::string& where = list[k].where;
+          throw std::invalid_argument((where.empty() ? "pins[" + std::to_string(k) + "]" : where) + ": " + e.what());
         }
       break;
   }

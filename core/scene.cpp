@@ -81,7 +81,7 @@ void per_kind(std::array<float, kSpringKinds>& out, const json& j, const std::st
 
 // A node selector: an index, "center" (when allowed), or {"box": [lo, hi]}, {"below": {"point":
 // p, "normal": n}}, {"nearest": p}.
-NodeSelector selector(const json& j, const std::string& where, bool center) {
+NodeSelector read_selector(const json& j, const std::string& where, bool center) {
   using K = NodeSelector::Kind;
   const char* expected = center ? "expected a node index, \"center\" or {\"nearest\": [x, y, z]}"
                                 : "expected a node index or one of {\"box\": ...}, {\"below\": ...}, {\"nearest\": ...}";
@@ -107,6 +107,11 @@ NodeSelector selector(const json& j, const std::string& where, bool center) {
   } else {
     bad(where, expected);
   }
+  return s;
+}
+NodeSelector selector(const json& j, const std::string& where, bool center) {
+  NodeSelector s = read_selector(j, where, center);
+  s.where = where;
   return s;
 }
 
@@ -276,6 +281,7 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
     const auto& p = j["pins"];
+    m.pins_where = where + ".pins";
     if (p.is_array() || p.is_object()) {
       m.pins = PinSet::list;
       m.pin_list.clear();
@@ -385,7 +391,7 @@ Params resolve_params(const Scene& s, const Model& m) {
     try {
       node = select_nodes(m, s.drag.node).at(0);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("drag ") + e.what());
+      throw std::invalid_argument((s.drag.node.where.empty() ? "drag node" : s.drag.node.where) + ": " + e.what());
     }
     p.drag.node = node;
     if (s.drag.offsets)

@@ -57,6 +57,7 @@ struct ModelSpec {
   Material material;
   PinSet pins = PinSet::top_corners;
   std::vector<NodeSelector> pin_list;
+  std::string pins_where;  // the scene key the pins were read from (empty: the default)
 };
 
 // The drag node: an index, "center" or the node nearest a point (resolved once the model exists).
