@@ -3,10 +3,6 @@
 // stage of the hybrid pipelines. One translation unit: kernels.cuh and temporal.cuh define the
 // kernels, force_kernels.cuh the model on the device and the force pass. It is compiled once
 // per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
-#include <thrust/execution_policy.h>
-#include <thrust/functional.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/transform_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -22,6 +18,7 @@
 #include <stdexcept>
 
 #include "check.cuh"
+#include "energy.cuh"
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
 #include "force_kernels.cuh"
@@ -30,56 +27,12 @@
 #include "core/step_params.hpp"
 #include "kernels.cuh"
 #include "temporal.cuh"
+#include "temporal_plan.cuh"
 #include "tma_tile.cuh"
 #include "math_builds.hpp"
 
 namespace deformlab::cuda::DL_CUDA_MATH {
 namespace {
-
-using PD = Physics<double>;
-__host__ __device__ Vec3d widen(const Vec3f& a) { return {a.x, a.y, a.z}; }
-
-struct NodeEnergy {
-  double kinetic, field;
-};
-struct NodeEnergyOp {
-  const float4* x;
-  const float4* v;
-  PD::StepParams sp;
-  __device__ NodeEnergy operator()(int i) const {
-    const float4 x4 = x[i];
-    return {PD::kinetic_energy(x4.w, widen(dev::xyz(v[i]))), PD::field_energy(sp, x4.w, widen(dev::xyz(x4)))};
-  }
-};
-struct AddNodeEnergy {
-  __device__ NodeEnergy operator()(const NodeEnergy& a, const NodeEnergy& b) const {
-    return {a.kinetic + b.kinetic, a.field + b.field};
-  }
-};
-struct SpringEnergyOp {
-  const Spring* springs;
-  const float4* x;
-  __device__ double operator()(std::int64_t e) const {
-    const Spring s = springs[e];
-    return PD::spring_energy(widen(dev::xyz(x[s.i])), widen(dev::xyz(x[s.j])), s.k, s.rest);
-  }
-};
-// Grids: node u's own springs (the second half of its stencil).
-struct GridSpringEnergyOp {
-  dev::StepParams sp;
-  Stencil st;
-  const float4* x;
-  __device__ double operator()(int u) const {
-    const int i = u % sp.nx, j = (u / sp.nx) % sp.ny, k = u / (sp.nx * sp.ny), n = sp.stencil_count;
-    double e = 0.0;
-    for (int q = n / 2; q < n; ++q) {
-      const P::StencilEntry& o = st.e[q];
-      const int w = P::grid_neighbour(sp, i, j, k, o.di, o.dj, o.dk);
-      if (w >= 0) e += PD::spring_energy(widen(dev::xyz(x[u])), widen(dev::xyz(x[w])), o.k, o.rest);
-    }
-    return e;
-  }
-};
 
 class Impl final : public CudaPipeline, private ForceKernels, private ForceStage, private UpdateStage {
  public:
@@ -88,7 +41,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     const Model& m = model_;
     n_ = m.node_count();
     fused_ = o_.variant == Variant::fused && sched_.single_pass();
-    if (o_.variant == Variant::temporal) plan_temporal();
+    if (o_.variant == Variant::temporal) {
+      temporal_ = true;
+      plan_ = plan_temporal(m, o_);
+    }
     sets_ = !temporal_ && sched_.rule == UpdateRule::verlet ? 3 : 2;
     if (dev::kPrefetchAhead && fused_ && m.grid()) plan_prefetch();
 
@@ -208,7 +164,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // stays until the next (one-step Verlet reads the positions before it from a third set;
   // cuda-temporal keeps them in prev_).
   bool can_step_back() const override { return true; }
-  int steps_per_launch() const override { return temporal_ ? k_ : 1; }
+  int steps_per_launch() const override { return temporal_ ? plan_.k : 1; }
   void step_back() override {
     if (back_ != Back::possible) throw std::logic_error("cuda pipeline: no launch to take back");
     cur_ = before(cur_);
@@ -270,26 +226,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   Energy energy() override {
     flush();
     if (!model_.grid() && !springs_.get() && model_.spring_count() > 0) upload_springs();
-    const auto policy = thrust::cuda::par.on(stream_);
-    const NodeEnergy ne = thrust::transform_reduce(
-        policy, thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
-        NodeEnergyOp{x_[cur_].get(), v_[cur_].get(), step_params<double>(model_, p_)}, NodeEnergy{0.0, 0.0},
-        AddNodeEnergy{});
-    const double se =
-        model_.grid()
-            ? thrust::transform_reduce(policy, thrust::counting_iterator<int>(0), thrust::counting_iterator<int>(n_),
-                                       GridSpringEnergyOp{sp_, stencil_, x_[cur_].get()}, 0.0, thrust::plus<double>())
-        : model_.spring_count() == 0
-            ? 0.0
-            : thrust::transform_reduce(policy, thrust::counting_iterator<std::int64_t>(0),
-                                       thrust::counting_iterator<std::int64_t>(model_.spring_count()),
-                                       SpringEnergyOp{springs_.get(), x_[cur_].get()}, 0.0, thrust::plus<double>());
-    check(cudaStreamSynchronize(stream_), "reducing the energies");
-    Energy e;
-    e.kinetic = ne.kinetic;
-    e.field = ne.field;
-    e.spring = se;
-    return e;
+    return model_energy(stream_, model_, step_params<double>(model_, p_), sp_, stencil_, springs_.get(),
+                        x_[cur_].get(), v_[cur_].get());
   }
 
   void set_profiler(Profiler* p) override {
@@ -505,64 +443,13 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // their own.
   Buffer<float4>& prev_x(int c) { return temporal_ && sched_.rule == UpdateRule::verlet ? prev_[c] : x_[before(c)]; }
 
-  // cuda-temporal's checks and launch shape: grids only; the tile's region (the tile and a
-  // halo of 2k nodes, two copies of x and v a cell) within the device's shared memory.
-  void plan_temporal() {
-    const Model& m = model_;
-    temporal_ = true;
-    k_ = cuda::steps_per_launch(o_);
-    const int halo = 2 * k_;
-    const bool volume = m.volume();
-    const std::size_t cell = 4 * sizeof(float4);
-    int device = 0, limit = 0, per_sm = 0, reserved = 0;
-    check(cudaGetDevice(&device), "finding the device");
-    check(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device),
-          "reading the shared-memory limit");
-    check(cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device),
-          "reading the shared memory of a multiprocessor");
-    check(cudaDeviceGetAttribute(&reserved, cudaDevAttrReservedSharedMemoryPerBlock, device),
-          "reading the shared memory reserved a block");
-    limit -= dev::kStopCheckShared;  // the kernel's own, beside the tile
-    temporal_shared_limit_ = limit;
-    TemporalTile t = o_.temporal_tile;
-    if (t.x == 0) {
-      // The largest square that leaves room for kTemporalBlocksPerSM blocks an SM; on lattices,
-      // whose halo grows in three axes, the largest cube that fits one.
-      const int blocks = volume ? 1 : dev::kTemporalBlocksPerSM;
-      const int share = std::min(limit, per_sm / blocks - reserved - dev::kStopCheckShared);
-      const int side = int(std::pow(double(std::size_t(share) / cell), volume ? 1.0 / 3.0 : 0.5) + 1e-9) - 2 * halo;
-      t = {side, side, volume ? side : 1};
-    }
-    if (!volume) t.z = 1;
-    if (t.z == 0) t.z = t.y;
-    const std::string need = "cuda-temporal: " + std::to_string(k_) + " steps a launch need a halo of " +
-                             std::to_string(halo) + " nodes around each tile; ";
-    if (t.x < 1)
-      throw std::invalid_argument(need + "no tile with it fits in the " + std::to_string(limit) +
-                                  " bytes of shared memory this device allows a block (choose fewer steps_per_launch)");
-    const std::int64_t cells = std::int64_t(t.x + 2 * halo) * (t.y + 2 * halo) * (volume ? t.z + 2 * halo : 1);
-    temporal_shared_ = std::size_t(cells) * cell;
-    if (temporal_shared_ > std::size_t(limit))
-      throw std::invalid_argument(need + "a tile of " + std::to_string(t.x) + "x" + std::to_string(t.y) +
-                                  (volume ? "x" + std::to_string(t.z) : "") + " nodes with it needs " +
-                                  std::to_string(temporal_shared_) + " bytes of shared memory, where this device allows " +
-                                  std::to_string(limit) + " a block (choose fewer steps_per_launch or a smaller tile)");
-    temporal_tile_ = int3{t.x, t.y, t.z};
-    if (temporal_blocks().y > 65535 || temporal_blocks().z > 65535)
-      throw std::invalid_argument("cuda-temporal: the grid exceeds the CUDA launch limits with this tile");
-  }
-  dim3 temporal_blocks() const {
-    const int3 t = temporal_tile_;
-    return dim3(unsigned((sp_.nx + t.x - 1) / t.x), unsigned((sp_.ny + t.y - 1) / t.y), unsigned((sp_.nz + t.z - 1) / t.z));
-  }
-
   // cuda-temporal's step: held until steps_per_launch steps can go in one launch.
   void hold_step() {
     held_t_[pending_++] = t_;
     t_ += p_.dt;
     stepped_ = true;
     back_ = Back::none;  // until these steps are launched
-    if (pending_ == k_) flush();
+    if (pending_ == plan_.k) flush();
   }
   // Launches the held steps, if any (before anything reads the state or its step times).
   void flush() {
@@ -578,17 +465,17 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       tg.step[q] = {p_.drag.target(held_t_[q]), p_.drag.target(held_t_[q] + p_.dt)};
     const int nxt = after(cur_);
     const bool verlet = Rule == RULE_VERLET;
-    const dim3 blocks = temporal_blocks(), threads(dev::kTemporalThreads);
+    const dim3 blocks = plan_.blocks(sp_.nx, sp_.ny, sp_.nz), threads(dev::kTemporalThreads);
     with_grid_flags([&](auto n, auto damped) {
       const auto kernel = dev::temporal_grid<n(), damped(), Rule>;
       // The limit is the kernel's, for every pipeline that launches it: raised to the device's
       // (the same for all), once for the one kernel this pipeline launches.
       if (!temporal_limit_raised_)
-        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, temporal_shared_limit_),
+        check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, plan_.shared_limit),
               "raising the temporal kernel's shared-memory limit");
       temporal_limit_raised_ = true;
-      kernel<<<blocks, threads, temporal_shared_, stream_>>>(
-          sp_, stencil_, float(sched_.weight()), pending_, temporal_tile_, x_[cur_].get(), v_[cur_].get(),
+      kernel<<<blocks, threads, plan_.shared, stream_>>>(
+          sp_, stencil_, float(sched_.weight()), pending_, plan_.tile, x_[cur_].get(), v_[cur_].get(),
           verlet ? prev_[cur_].get() : nullptr, has_prev_, x_[nxt].get(), v_[nxt].get(),
           verlet ? prev_[nxt].get() : nullptr, tg, stop_check());
     });
@@ -666,11 +553,9 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // cuda-temporal: steps are held back until a launch can take steps_per_launch of them (or
   // something reads the state); t_ then counts the held steps too.
   bool temporal_ = false;
-  int k_ = 1, pending_ = 0;  // steps a launch, steps held
-  int3 temporal_tile_{};
+  TemporalPlan plan_;
+  int pending_ = 0;  // steps held
   double held_t_[dev::kMaxStepsPerLaunch] = {};  // the held steps' start times
-  std::size_t temporal_shared_ = 0;
-  int temporal_shared_limit_ = 0;  // the device's, less the kernel's static shared memory
   bool temporal_limit_raised_ = false;
 };
 
