@@ -279,7 +279,9 @@ struct Renderer::Impl {
   }
 
   // After the model, depth-tested without writing depth: the model hides them, and surface_at
-  // finds only the model. A sphere culls its back faces (convex: each pixel gets its front) and
+  // finds only the model. They are drawn a thousandth of the view distance inside their
+  // surfaces (obstacle.vert), far more than the depth buffer resolves there and than a sphere's
+  // facets or a model's triangles depart from the true surface. A sphere culls its back faces (convex: each pixel gets its front) and
   // drops what lies on the other side of the ground from the eye (obstacle.frag); spheres that
   // cut into each other are drawn whole, the nearer centre over the other.
   void draw_obstacles(const Mat4& vp) {
@@ -288,6 +290,7 @@ struct Renderer::Impl {
     glUseProgram(id);
     glUniformMatrix4fv(uniform(id, "u_view_proj"), 1, GL_FALSE, vp.data());
     glUniform3f(uniform(id, "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
+    glUniform1f(uniform(id, "u_inset"), 1e-3f * norm(camera.eye - camera.target));
     glDepthMask(GL_FALSE);
     glUniform1i(uniform(id, "u_has_ground"), o.ground.has_value());
     glUniform1f(uniform(id, "u_ground"), o.ground.value_or(0.f));

@@ -1,5 +1,6 @@
 // Rendering: the cloth shows where the camera looks, from GL buffers and from CPU states.
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -230,6 +231,46 @@ TEST(GlRender, GroundAndSpheresWhereTheModelDoesNotHideThem) {
   const auto picked = r.surface_at(cx, cy);
   ASSERT_TRUE(picked) << "the cloth is picked";
   EXPECT_NEAR(picked->y, 1.f, 0.01f);
+}
+
+// A model resting on the obstacles, exactly on their surfaces where the constraints put it (a
+// cloth on the ground and over the cap of a sphere that rises through it), shows whole in front
+// of them: every pixel of the cloth is what it is without obstacles, none the ground's or the
+// sphere's. (The cap is low enough that the cloth's triangles, chords between nodes on the
+// sphere, stay outside it.)
+TEST(GlRender, AModelRestingOnTheObstaclesShowsInFrontOfThem) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = cloth_grid(49, 49, 0.75f / 48, 1.f, Material{});  // horizontal, 0.75 m wide, at y = 1
+  const int w = 256, h = 256;
+  const float ground_y = 1.f, radius = 0.2f;
+  const Vec3f centre = {0.f, ground_y - 0.1f, 0.f};  // a cap 0.1 m high and 0.35 m across
+  State s = rest_state(m);
+  int on_sphere = 0;
+  for (Vec3f& x : s.x) {
+    const float q = radius * radius - x.x * x.x - x.z * x.z;
+    if (q <= 0.f || centre.y + std::sqrt(q) <= ground_y) continue;
+    x.y = centre.y + std::sqrt(q);
+    ++on_sphere;
+  }
+  ASSERT_GT(on_sphere, 300);
+  const gl::Camera cam = gl::framing(m, ground_y);
+  gl::RenderOptions look{w, h};
+  look.ground = ground_y;
+  look.spheres = {{centre, radius}};
+  gl::Renderer with(m, look), alone(m, {w, h});
+  with.set_camera(cam);
+  alone.set_camera(cam);
+  with.draw(s);
+  alone.draw(s);
+  const auto a = alone.pixels(), b = with.pixels();
+  long cloth = 0, changed = 0;
+  for (std::size_t i = 0; i < a.size(); i += 4) {
+    if (a[i] == a[0] && a[i + 1] == a[1] && a[i + 2] == a[2]) continue;  // the background
+    ++cloth;
+    changed += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
+  }
+  EXPECT_GT(cloth, 2000);
+  EXPECT_EQ(changed, 0) << "of " << cloth << " cloth pixels: the ground or the sphere drawn through the cloth";
 }
 
 // The ground hides what of a sphere lies under it: a sphere wholly under the ground leaves the
