@@ -126,9 +126,13 @@ struct Reader {
     out.array(m.tetrahedron);
     out.count(notes.size());
     for (const auto& n : notes) out.text(n);
-  } catch (const std::bad_alloc&) {
-    out.bytes(&kError, 1);
-    out.text(what + ": reading it took more than " + cap + " (damaged counts?)");
+  } catch (const std::bad_alloc& e) {
+    if (!out_of_memory) {  // std::bad_array_new_length: no allocation was tried
+      fail(what + ": " + e.what());
+    } else {
+      out.bytes(&kError, 1);
+      out.text(what + ": reading it took more than " + cap + " (damaged counts?)");
+    }
   } catch (const std::exception& e) {
     fail(e.what());
   } catch (...) {
