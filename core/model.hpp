@@ -104,13 +104,13 @@ struct NodeSelector {
   enum class Kind : std::uint8_t { index, box, below, nearest, center } kind = Kind::index;
   int index = -1;
   Vec3f a{}, b{};  // box: lowest and highest corner; below: a point of the plane and its upward normal; nearest: a
-  std::string where;  // the scene key it was read from, which its errors name (empty: made in code)
+  std::string where;  // the scene key it was read from, for errors (empty: made in code)
   static NodeSelector node(int v) { return {Kind::index, v}; }
   bool single() const { return kind == Kind::index || kind == Kind::nearest || kind == Kind::center; }
 };
 // The model's nodes a selector picks, in ascending order (model numbering); throws
-// std::invalid_argument when an index is outside the model or a selector picks nothing,
-// naming the selector's scene key where it has one.
+// std::invalid_argument when an index is outside the model or a selector picks nothing (its
+// callers put the selector's scene key before the message).
 std::vector<int> select_nodes(const Model& m, const NodeSelector& s);
 
 enum class PinSet : std::uint8_t { none, top_corners, top_row, list };

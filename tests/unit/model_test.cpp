@@ -117,7 +117,19 @@ TEST(Builders, PinSets) {
   EXPECT_EQ(pin_nodes(c, PinSet::top_corners, {}), (std::vector<int>{0, 5}));
   EXPECT_EQ(pin_nodes(c, PinSet::top_row, {}), (std::vector<int>{0, 1, 2, 3, 4, 5}));
   EXPECT_EQ(pin_nodes(c, PinSet::list, {NodeSelector::node(7), NodeSelector::node(9)}), (std::vector<int>{7, 9}));
-  EXPECT_THROW(pin_nodes(c, PinSet::list, {NodeSelector::node(24)}), std::invalid_argument);
+  // A selector's error names its scene key, or its place in the list when it was made in code.
+  auto error = [&](std::vector<NodeSelector> list) {
+    try {
+      pin_nodes(c, PinSet::list, list);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("none");
+  };
+  EXPECT_EQ(error({NodeSelector::node(7), NodeSelector::node(24)}), "pins[1]: node 24 is outside the model (0..23)");
+  NodeSelector read = NodeSelector::node(24);
+  read.where = "s.json.model.pins[3]";
+  EXPECT_EQ(error({read}), "s.json.model.pins[3]: node 24 is outside the model (0..23)");
   const Model l = lattice(3, 4, 2, 0.1f, 0.f, Material{});
   // lattice top corners: (0, ny-1, 0) and (nx-1, ny-1, 0), the top layer being y max.
   const auto tc = pin_nodes(l, PinSet::top_corners, {});
