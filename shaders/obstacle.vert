@@ -3,8 +3,9 @@
 // square (u_kind 0: centre u_center, half its side u_size), a sphere as u_grid.x slices by
 // u_grid.y stacks of quads between its poles (u_kind 1: centre u_center, radius u_size; its
 // faces wind counter-clockwise seen from outside). Both are drawn u_inset inside their
-// surface (the ground lower, a sphere smaller), so that a model resting on them, exactly on
-// their surface where the constraints put it, is seen in front of them, not interleaved.
+// surface (the ground lower, a sphere smaller, but by half its radius at most), so that a model
+// resting on them, exactly on their surface where the constraints put it, is seen in front of
+// them, not interleaved.
 uniform mat4 u_view_proj;
 uniform int u_kind;
 uniform vec3 u_center;

@@ -236,8 +236,9 @@ TEST(GlRender, GroundAndSpheresWhereTheModelDoesNotHideThem) {
 // A model resting on the obstacles, exactly on their surfaces where the constraints put it (a
 // cloth on the ground and over the cap of a sphere that rises through it), shows whole in front
 // of them: every pixel of the cloth is what it is without obstacles, none the ground's or the
-// sphere's. (The cap is low enough that the cloth's triangles, chords between nodes on the
-// sphere, stay outside it.)
+// sphere's, while the ground shows around it and a sphere beside it shows whole. (The cap is
+// low enough that the cloth's triangles, chords between nodes on the sphere, dip into it by
+// less than the drawing's inset.)
 TEST(GlRender, AModelRestingOnTheObstaclesShowsInFrontOfThem) {
   DEFORMLAB_REQUIRE_GL();
   const Model m = cloth_grid(49, 49, 0.75f / 48, 1.f, Material{});  // horizontal, 0.75 m wide, at y = 1
@@ -256,21 +257,35 @@ TEST(GlRender, AModelRestingOnTheObstaclesShowsInFrontOfThem) {
   const gl::Camera cam = gl::framing(m, ground_y);
   gl::RenderOptions look{w, h};
   look.ground = ground_y;
-  look.spheres = {{centre, radius}};
+  const Vec3f beside = {0.6f, ground_y + 0.1f, 0.f};  // right of the cloth's edge, above the ground
+  look.spheres = {{centre, radius}, {beside, 0.08f}};
   gl::Renderer with(m, look), alone(m, {w, h});
   with.set_camera(cam);
   alone.set_camera(cam);
   with.draw(s);
   alone.draw(s);
   const auto a = alone.pixels(), b = with.pixels();
-  long cloth = 0, changed = 0;
+  long cloth = 0, changed = 0, ground = 0;
   for (std::size_t i = 0; i < a.size(); i += 4) {
-    if (a[i] == a[0] && a[i + 1] == a[1] && a[i + 2] == a[2]) continue;  // the background
+    if (a[i] == a[0] && a[i + 1] == a[1] && a[i + 2] == a[2]) {  // the background without obstacles
+      ground += std::abs(int(b[i]) - int(b[i + 2])) <= 12 && b[i] != a[0];
+      continue;
+    }
     ++cloth;
     changed += a[i] != b[i] || a[i + 1] != b[i + 1] || a[i + 2] != b[i + 2];
   }
   EXPECT_GT(cloth, 2000);
   EXPECT_EQ(changed, 0) << "of " << cloth << " cloth pixels: the ground or the sphere drawn through the cloth";
+  EXPECT_GT(ground, w * h / 10) << "the ground's grey around the cloth";
+  // The sphere beside the cloth, drawn at its radius less the inset: blue-grey a pixel inside its
+  // outline at the height of its centre, the ground's grey a pixel outside.
+  const auto [sx, sy] = cam.pixel(beside, w, h);
+  const auto [ex, ey] = cam.pixel(beside + Vec3f{0.08f, 0.f, 0.f}, w, h);
+  auto px = [&](double x, double y) { return &b[(std::size_t(y) * w + std::size_t(x)) * 4]; };
+  const std::uint8_t *mid = px(sx, sy), *in = px(ex - 2, ey), *out = px(ex + 2, ey);
+  EXPECT_GT(int(mid[2]), int(mid[0]) + 20) << "blue-grey at its centre";
+  EXPECT_GT(int(in[2]), int(in[0]) + 20) << "blue-grey just inside its outline";
+  EXPECT_LE(std::abs(int(out[2]) - int(out[0])), 12) << "the ground just outside its outline";
 }
 
 // The ground hides what of a sphere lies under it: a sphere wholly under the ground leaves the
