@@ -1,8 +1,10 @@
 // cuda-temporal's launch shape: its steps a launch and its tile, checked against the device's
 // shared memory, and the blocks that cover a grid.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 

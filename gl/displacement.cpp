@@ -1,6 +1,7 @@
 // The GL pipelines' step back and their stop rule's read-back: the largest displacement of a
 // step, reduced into a word a state set (reduce_displacement, or posted by the result pass
 // itself) and read through a persistently mapped buffer.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
