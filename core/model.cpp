@@ -185,29 +185,34 @@ std::vector<int> select_nodes(const Model& m, const NodeSelector& s) {
   return out;
 }
 
-std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list) {
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list,
+                           const std::string& where) {
   std::vector<int> out;
-  const bool grid = m.topology != Topology::general;
+  auto needs_grid = [&](const char* name) {
+    if (m.topology == Topology::general)
+      throw std::invalid_argument((where.empty() ? "" : where + ": ") + "pin set '" + name +
+                                  "' needs a grid or lattice (pin meshes by position)");
+  };
   // "top": cloth row j = 0; lattice layer j = ny-1 (front row k = 0 for corners / row).
   const int top_j = m.topology == Topology::lattice ? m.ny - 1 : 0;
   auto node = [&](int i, int j, int k) { return (k * m.ny + j) * m.nx + i; };
   switch (set) {
     case PinSet::none: break;
     case PinSet::top_corners:
-      if (!grid) throw std::invalid_argument("pin set 'top-corners' needs a grid or lattice (pin meshes by position)");
+      needs_grid("top-corners");
       out.push_back(node(0, top_j, 0));
       if (m.nx > 1) out.push_back(node(m.nx - 1, top_j, 0));
       break;
     case PinSet::top_row:
-      if (!grid) throw std::invalid_argument("pin set 'top-row' needs a grid or lattice (pin meshes by position)");
+      needs_grid("top-row");
       for (int i = 0; i < m.nx; ++i) out.push_back(node(i, top_j, 0));
       break;
     case PinSet::list:
       for (std::size_t k = 0; k < list.size(); ++k) try {
           for (int v : select_nodes(m, list[k])) out.push_back(v);
         } catch (const std::invalid_argument& e) {
-          const std::string& where = list[k].where;
-          throw std::invalid_argument((where.empty() ? "pins[" + std::to_string(k) + "]" : where) + ": " + e.what());
+          const std::string& key = list[k].where;
+          throw std::invalid_argument((key.empty() ? "pins[" + std::to_string(k) + "]" : key) + ": " + e.what());
         }
       break;
   }

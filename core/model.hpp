@@ -115,8 +115,9 @@ std::vector<int> select_nodes(const Model& m, const NodeSelector& s);
 
 enum class PinSet : std::uint8_t { none, top_corners, top_row, list };
 // Nodes of a pin set: top corners / top row of a grid or lattice, or every node the list's
-// selectors pick.
-std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list);
+// selectors pick. Errors name the scene key: `where` (the set's) or the selector's own.
+std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSelector>& list,
+                           const std::string& where = "");
 void pin(Model& m, const std::vector<int>& nodes);
 
 // Rest length of a grid's springs along offset o: spacing x |o|.

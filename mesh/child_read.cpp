@@ -110,9 +110,12 @@ struct Reader {
   });
   const std::string cap = "the " + gib(limits.memory) + " of memory allowed for a file of its size";
   Writer out{fd};
-  auto fail = [&](const std::string& error) {
+  auto send = [&](const std::string& error) {
     out.bytes(&kError, 1);
-    out.text(out_of_memory ? error + " (an allocation past " + cap + " failed before: damaged counts?)" : error);
+    out.text(error);
+  };
+  auto fail = [&](const std::string& error) {
+    send(out_of_memory ? error + " (an allocation past " + cap + " failed before: damaged counts?)" : error);
   };
   try {
     std::vector<std::string> notes;
@@ -126,13 +129,9 @@ struct Reader {
     out.array(m.tetrahedron);
     out.count(notes.size());
     for (const auto& n : notes) out.text(n);
-  } catch (const std::bad_alloc& e) {
-    if (!out_of_memory) {  // std::bad_array_new_length: no allocation was tried
-      fail(what + ": " + e.what());
-    } else {
-      out.bytes(&kError, 1);
-      out.text(what + ": reading it took more than " + cap + " (damaged counts?)");
-    }
+  } catch (const std::bad_alloc& e) {  // not past the cap: std::bad_array_new_length
+    if (out_of_memory) send(what + ": reading it took more than " + cap + " (damaged counts?)");
+    else fail(what + ": " + e.what());
   } catch (const std::exception& e) {
     fail(e.what());
   } catch (...) {

@@ -148,12 +148,7 @@ Model build_model_in_file_order(const Scene& s) {
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
   }
-  try {
-    pin(model, pin_nodes(model, m.pins, m.pin_list));  // before reordering: indices are the file's
-  } catch (const std::invalid_argument& e) {
-    if (m.pins == PinSet::list || m.pins_where.empty()) throw;  // a list's selectors name their keys
-    throw std::invalid_argument(m.pins_where + ": " + e.what());
-  }
+  pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;
 }
 
