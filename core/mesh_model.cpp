@@ -93,6 +93,12 @@ std::int64_t drop_duplicates(std::vector<std::array<std::int32_t, N>>& elements)
 
 }  // namespace
 
+std::string non_finite_vertex(const Vec3f& p) {
+  std::ostringstream os;
+  os << "a vertex has a NaN or infinite coordinate (" << p.x << ", " << p.y << ", " << p.z << ")";
+  return os.str();
+}
+
 std::vector<std::string> repair(Mesh& m) {
   const std::int64_t n = std::int64_t(m.position.size());
   if (m.triangle.empty() && m.tetrahedron.empty()) bad("the mesh has no triangles or tetrahedra");
@@ -100,8 +106,7 @@ std::vector<std::string> repair(Mesh& m) {
   if (n > (std::int64_t(1) << 30)) bad("mesh of " + std::to_string(n) + " vertices exceeds the limit of 2^30 nodes");
   for (std::int64_t v = 0; v < n; ++v)
     for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(m.position[v][c]))
-        bad("vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      if (!std::isfinite(m.position[v][c])) bad(non_finite_vertex(m.position[v]));
   std::int64_t element = 0;
   for_each_index(m, [&](std::int32_t v) {
     if (v < 0 || v >= n)
@@ -175,7 +180,10 @@ void walk_sides(std::vector<Side<N>>& sides, std::vector<Key>& flexion, Boundary
       boundary(sides[a]);
     } else {
       std::string nodes;
-      for (auto v : sides[a].v) nodes += (nodes.empty() ? "" : "-") + std::to_string(v);
+      for (auto v : sides[a].v) {
+        if (!nodes.empty()) nodes += '-';
+        nodes += std::to_string(v);
+      }
       bad(std::string(N == 2 ? "edge " : "face ") + nodes + " is shared by " + std::to_string(b - a) +
           (N == 2 ? " triangles" : " tetrahedra") + " (non-manifold)");
     }

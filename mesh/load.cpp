@@ -10,7 +10,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -56,11 +55,8 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   for (unsigned k = 0; k < scene->mNumMeshes; ++k)
     for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
       if (const aiVector3D& p = scene->mMeshes[k]->mVertices[v];
-          !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        std::ostringstream at;
-        at << "a vertex has a NaN or infinite coordinate (" << p.x << ", " << p.y << ", " << p.z << ")";
-        bad(path, at.str());
-      }
+          !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        bad(path, non_finite_vertex({p.x, p.y, p.z}));
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
                                        aiProcess_SortByPType | aiProcess_ValidateDataStructure);

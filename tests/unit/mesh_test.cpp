@@ -190,7 +190,7 @@ TEST(MeshModel, MalformedMeshesAreRefusedByName) {
   EXPECT_EQ(error_of(empty), "the mesh has no triangles or tetrahedra");
   Mesh nan = triangulated_square(3, 3);
   nan.position[5].y = NAN;
-  EXPECT_EQ(error_of(nan), "vertex 5 has a NaN or infinite coordinate");
+  EXPECT_EQ(error_of(nan), "a vertex has a NaN or infinite coordinate (0.1, nan, 0.05)");
   Mesh outside = triangulated_square(3, 3);
   outside.triangle[2][1] = 40;
   EXPECT_EQ(error_of(outside), "element 2 refers to vertex 40, outside 0..8");
