@@ -258,6 +258,7 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     else if (t == "mesh") m.topology = Topology::general;
     else bad(where + ".type", "expected \"cloth\", \"lattice\" or \"mesh\"");
   }
+  m.where = where;
   const bool mesh = m.topology == Topology::general;
   for (const char* k : {"size", "spacing", "width", "height"})
     if (mesh && j.contains(k)) bad(where + "." + k, "not a key of a mesh model (its size comes from the file)");
