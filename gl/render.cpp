@@ -279,9 +279,10 @@ struct Renderer::Impl {
   }
 
   // After the model, depth-tested without writing depth: the model hides them, and surface_at
-  // finds only the model. They are drawn a thousandth of the view distance inside their
-  // surfaces (obstacle.vert): 50 times what the depth buffer resolves there, and more than a
-  // sphere's facets depart from it. A model resting on them then shows in front wherever its
+  // finds only the model. They are drawn a thousandth of the view distance behind their
+  // surfaces (obstacle.vert: the ground lower, a sphere along the eye's rays, so that its outline
+  // keeps its size): 50 times what the depth buffer resolves there, and more than a sphere's
+  // facets depart from it. A model resting on them then shows in front wherever its
   // triangles, chords between nodes on the surface, dip into a sphere by less than that (a
   // chord of length L by L^2 / 8R on a sphere of radius R). A sphere culls its back faces
   // (convex: each pixel gets its front) and drops what lies on the other side of the ground from

@@ -277,8 +277,8 @@ TEST(GlRender, AModelRestingOnTheObstaclesShowsInFrontOfThem) {
   EXPECT_GT(cloth, 2000);
   EXPECT_EQ(changed, 0) << "of " << cloth << " cloth pixels: the ground or the sphere drawn through the cloth";
   EXPECT_GT(ground, w * h / 10) << "the ground's grey around the cloth";
-  // The sphere beside the cloth, drawn at its radius less the inset: blue-grey a pixel inside its
-  // outline at the height of its centre, the ground's grey a pixel outside.
+  // The sphere beside the cloth: blue-grey a pixel inside its outline at the height of its centre,
+  // the ground's grey a pixel outside.
   const auto [sx, sy] = cam.pixel(beside, w, h);
   const auto [ex, ey] = cam.pixel(beside + Vec3f{0.08f, 0.f, 0.f}, w, h);
   auto px = [&](double x, double y) { return &b[(std::size_t(y) * w + std::size_t(x)) * 4]; };
@@ -329,6 +329,47 @@ TEST(GlRender, ANearerSphereCoversOneBehindIt) {
   EXPECT_EQ(pixels_differing(a, b, w, h, int(sx), int(sy), 3), 0)
       << "of 49 pixels at the near sphere's centre, the far sphere drawn over it";
   EXPECT_GT(coverage(b, w, h).pixels, coverage(a, w, h).pixels + 200) << "the far sphere around the near one";
+}
+
+// A sphere shows at its own size, not shrunk by the inset that keeps it behind a model resting
+// on it: at 2048 x 2048, where a sphere drawn that much smaller showed 3 px short of its outline
+// on each side, the row through its centre is blue-grey to within 1.5 px of its outline on both
+// sides (its 48 slices' chords fall a fraction of a pixel short of it) and not 1.5 px outside it.
+TEST(GlRender, ASphereShowsAtItsOwnSize) {
+  DEFORMLAB_REQUIRE_GL();
+  const Model m = small_cloth(16, 16);
+  const int w = 2048, h = 2048;
+  const float ground_y = 0.6f, radius = 0.08f;
+  const Vec3f centre = {0.6f, ground_y + 0.1f, 0.f};
+  const gl::Camera cam = gl::framing(m, ground_y);
+  gl::RenderOptions look{w, h};
+  look.ground = ground_y;
+  look.spheres = {{centre, radius}};
+  gl::Renderer renderer(m, look);
+  renderer.set_camera(cam);
+  renderer.draw(rest_state(m));
+  const auto b = renderer.pixels();
+  // Its outline on the row through its centre: where the pixels' rays graze it (bisection).
+  const double row = cam.pixel(centre, w, h)[1], middle = cam.pixel(centre, w, h)[0];
+  auto outside = [&](double x) {
+    const auto [eye, ray] = cam.ray(x, row, w, h);
+    const Vec3f to = centre - eye;
+    return norm(to - ray * dot(to, ray)) > radius;
+  };
+  auto edge = [&](double far) {
+    double in = middle;
+    for (int k = 0; k < 40; ++k) (outside((in + far) / 2) ? far : in) = (in + far) / 2;
+    return in;
+  };
+  const double left = edge(0), right_edge = edge(w - 1);
+  auto blue = [&](double x) {
+    const std::uint8_t* p = &b[(std::size_t(row) * w + std::size_t(x)) * 4];
+    return int(p[2]) > int(p[0]) + 20;
+  };
+  EXPECT_TRUE(blue(left + 1.5)) << "blue-grey 1.5 px inside its left outline";
+  EXPECT_TRUE(blue(right_edge - 1.5)) << "blue-grey 1.5 px inside its right outline";
+  EXPECT_FALSE(blue(left - 1.5)) << "not blue-grey 1.5 px outside its left outline";
+  EXPECT_FALSE(blue(right_edge + 1.5)) << "not blue-grey 1.5 px outside its right outline";
 }
 
 TEST(GlRender, LatticeAsPointsAndPngFile) {
