@@ -58,7 +58,7 @@ struct ModelSpec {
   PinSet pins = PinSet::top_corners;
   std::vector<NodeSelector> pin_list;
   std::string pins_where;  // the scene key the pins were read from (empty: the default)
-  std::string where;       // the scene key of the model (of the last scene layer that set it)
+  std::string where;       // the scene key of the model (of the last scene layer with a "model")
 };
 
 // The drag node: an index, "center" or the node nearest a point (resolved once the model exists).

@@ -144,6 +144,12 @@ const std::vector<BadInput>& cases() {
            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
       mesh("mesh_two_nans", "{\"file\": \"m.obj\"}", "m.obj': a vertex has a NaN or infinite coordinate",
            "v 0 0 0\nv 1 nan 0\nv nan 1 0\nf 1 2 3\n"),
+      mesh("mesh_msh_nan", "{\"file\": \"m.msh\"}", "m.msh': a vertex has a NaN or infinite coordinate (0, nan, 0)",
+           "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n0 nan 0\n0 0 1\n"
+           "$EndNodes\n$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n",
+           "m.msh"),
+      mesh("mesh_scale_overflow", "{\"file\": \"m.obj\", \"scale\": 1e38}",
+           "m.obj': its scale and transform take the vertex (10, 0, 0) out of the float range", "v 0 0 0\nv 10 0 0\nv 0 1 0\nf 1 2 3\n"),
       mesh("mesh_ply_nan", "{\"file\": \"m.ply\"}", "m.ply': a vertex has a NaN or infinite coordinate",
            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n",
