@@ -258,8 +258,9 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     else if (t == "mesh") m.topology = Topology::general;
     else bad(where + ".type", "expected \"cloth\", \"lattice\" or \"mesh\"");
   }
-  m.where = where;
   const bool mesh = m.topology == Topology::general;
+  if (mesh && j.contains("type") && !j.contains("pins") && m.pins != PinSet::none && m.pins != PinSet::list)
+    m.pins_where = where + ".pins (absent: " + (m.pins_where.empty() ? "the default" : "from " + m.pins_where) + ")";
   for (const char* k : {"size", "spacing", "width", "height"})
     if (mesh && j.contains(k)) bad(where + "." + k, "not a key of a mesh model (its size comes from the file)");
   for (const char* k : {"file", "generate", "scale", "transform", "density", "fill", "cell_size", "order", "seed"})

@@ -57,8 +57,9 @@ struct ModelSpec {
   Material material;
   PinSet pins = PinSet::top_corners;
   std::vector<NodeSelector> pin_list;
-  std::string pins_where;  // the scene key the pins were read from (empty: the default)
-  std::string where;       // the scene key of the model (of the last scene layer with a "model")
+  // The scene key that names the pins in errors: where they were read, or, where a scene layer
+  // made the model a mesh without giving pins, that layer's key for them marked absent.
+  std::string pins_where;
 };
 
 // The drag node: an index, "center" or the node nearest a point (resolved once the model exists).

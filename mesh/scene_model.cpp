@@ -157,8 +157,7 @@ Model build_model_in_file_order(const Scene& s) {
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
   }
-  const std::string pins_key = m.pins_where.empty() && !m.where.empty() ? m.where + ".pins (absent: the default)" : m.pins_where;
-  pin(model, pin_nodes(model, m.pins, m.pin_list, pins_key));  // before reordering: indices are the file's
+  pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;
 }
 
