@@ -99,17 +99,13 @@ std::string non_finite_vertex(const Vec3f& p) {
   return os.str();
 }
 
-void require_finite(const Mesh& m) {
-  for (const Vec3f& p : m.position)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) bad(non_finite_vertex(p));
-}
-
 std::vector<std::string> repair(Mesh& m) {
   const std::int64_t n = std::int64_t(m.position.size());
   if (m.triangle.empty() && m.tetrahedron.empty()) bad("the mesh has no triangles or tetrahedra");
   if (!m.triangle.empty() && !m.tetrahedron.empty()) bad("the mesh mixes triangles and tetrahedra");
   if (n > (std::int64_t(1) << 30)) bad("mesh of " + std::to_string(n) + " vertices exceeds the limit of 2^30 nodes");
-  require_finite(m);
+  for (const Vec3f& p : m.position)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) bad(non_finite_vertex(p));
   std::int64_t element = 0;
   for_each_index(m, [&](std::int32_t v) {
     if (v < 0 || v >= n)

@@ -38,9 +38,8 @@ std::vector<std::string> repair(Mesh& m);
 
 // "a vertex has a NaN or infinite coordinate (nan, 0, 0)": that error's words wherever a mesh's
 // vertices are checked. The coordinates name the vertex: a library's vertex order need not be
-// the file's. require_finite throws it for the first such vertex of m.
+// the file's.
 std::string non_finite_vertex(const Vec3f& p);
-void require_finite(const Mesh& m);
 
 // The model of a repaired mesh. density > 0: lumped masses (kg/m^2 for surfaces, kg/m^3 for
 // volumes); 0: every node weighs mat.node_mass. Model::triangle holds the surface (a

@@ -13,14 +13,17 @@ namespace deformlab {
 
 namespace {
 
-// Scales and transforms the vertices of a mesh whose coordinates are all finite; refuses a vertex
-// that they take out of the float range.
+bool finite(const Vec3f& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+// Scales and transforms a mesh's vertices, refusing one that is not finite as read (before the
+// transform spreads a NaN to its other coordinates) or that they take out of the float range.
 void place(Mesh& m, const MeshSpec& s) {
   const auto& t = s.transform;
   for (auto& p : m.position) {
+    if (!finite(p)) throw std::invalid_argument(non_finite_vertex(p));
     const Vec3f from = p, q{p.x * s.scale.x, p.y * s.scale.y, p.z * s.scale.z};
     for (int r = 0; r < 3; ++r) p[r] = t[r * 4] * q.x + t[r * 4 + 1] * q.y + t[r * 4 + 2] * q.z + t[r * 4 + 3];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    if (!finite(p)) {
       std::ostringstream os;
       os << "its scale and transform take the vertex (" << from.x << ", " << from.y << ", " << from.z
          << ") out of the float range";
@@ -97,7 +100,6 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
                 const std::string& fill_to = {}) {
   Mesh mesh = source_mesh(ms, what, notes);
   return naming(what, [&] {
-    require_finite(mesh);  // as read: the transform would spread a NaN to its vertex's other coordinates
     place(mesh, ms);
     for (auto& line : repair(mesh)) notes.push_back(std::move(line));
     if (ms.fill) {
