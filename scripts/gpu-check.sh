@@ -3,8 +3,8 @@
 # suite, compute-sanitizer on a small run of every CUDA kernel, the CUDA and GL benchmarks
 # and the GPU experiments (Tables 2 and 3, tiles; hybrid ones when built). Logs and results
 # go into $1 (default gpu-check/); a short table is printed last.
-# Environment: PARTS (which of "tests sanitizers bench experiments timing mesh scale endurance speed"
-# to run, default all but timing, mesh, scale, endurance and speed),
+# Environment: PARTS (which of "tests sanitizers bench experiments timing mesh scale endurance speed profile"
+# to run, default all but timing, mesh, scale, endurance, speed and profile),
 # BUILD (build folder, default build/default), MAX_SIZE (largest experiment grid; mesh sweeps take none,
 # default 4096), EXPERIMENTS (default "table2 table3 tiles interop swap"), JOBS (ctest -j, default 4),
 # LABELS (the tests part's ctest -L regex, default every label), SANITIZERS and MATCH_SHARDS (the
@@ -108,30 +108,48 @@ if part bench; then
 fi
 
 # The roofline work: cuda-fused in exact and fast math and cuda-temporal's steps per launch
-# (bench), Nsight Compute's view of the fused and temporal kernels on the paper's scene at
-# 2048^2, and cuda-temporal timed by run, by its experiment cell and by the bench.
+# (bench), and cuda-temporal timed by run, by its experiment cell and by the bench.
 if part speed; then
   "$bench" cuda --sizes 2048 --variants fused --integrator explicit-euler --graph-sizes 64 --tiles 16x8 32x8 32x16 64x4 \
     --temporal-sizes 2048 8192 --csv "$out/speed-bench.csv" >"$out/speed-bench.txt" 2>&1
-  if command -v ncu >/dev/null; then
-    for math in exact fast; do
-      for integ in explicit-euler semi-implicit-euler verlet; do
-        ncu --kernel-name regex:fused_ --launch-skip 20 --launch-count 1 --section SpeedOfLight \
-          --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis --section InstructionStats \
-          --section WarpStateStats --section Occupancy --section LaunchStats \
-          "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-fused --integrator "$integ" \
-          --option math=$math --steps 30 --no-state --out "/tmp/ncu-run" >"$out/ncu-fused-$integ-$math.txt" 2>&1
-      done
-      ncu --kernel-name regex:temporal_grid --launch-skip 5 --launch-count 1 --section SpeedOfLight \
-        --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis --section InstructionStats \
-        --section WarpStateStats --section Occupancy --section LaunchStats \
-        "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-temporal --integrator semi-implicit-euler \
-        --option math=$math --steps 40 --check-every 4 --no-state --out "/tmp/ncu-run" >"$out/ncu-temporal-$math.txt" 2>&1
-    done
-  fi
   "$app" run --experiment table2 --grid 2048x2048 --pipeline cuda-temporal --integrator semi-implicit-euler \
     --steps 400 --check-every 4 --no-state --out /tmp/speed-run >"$out/speed-run-temporal.txt" 2>&1
   summary+=("speed: $(grep -A200 '^\[temporal\]' "$out/speed-bench.txt" | grep -E '^ *2048\^2 *semi-implicit' | tr -s ' ' | head -10 | tr '\n' ';')")
+fi
+
+# Nsight Compute on table2's scene at 2048^2 (its default clock control: the SM clock locked at
+# base): cuda-fused in both maths and integrators, cuda-temporal, the bare gather (the bench's,
+# each of its kernels at its 21st launch), and the force passes of cuda-naive and cuda-tiled.
+# Beside the sections, the counts behind the bounds in docs/speed.md: warp instructions (at most
+# one a scheduler and cycle) and L1 data-pipe wavefronts (at most one an SM and cycle). The
+# programs' own output is dropped: their timings under the profiler are not the kernels'.
+if part profile && command -v ncu >/dev/null; then
+  sections=(--section SpeedOfLight --section MemoryWorkloadAnalysis --section ComputeWorkloadAnalysis
+    --section InstructionStats --section WarpStateStats --section Occupancy --section LaunchStats
+    --metrics smsp__inst_executed.sum,l1tex__data_pipe_lsu_wavefronts.sum,l1tex__data_pipe_lsu_wavefronts.avg.pct_of_peak_sustained_elapsed,l1tex__m_xbar2l1tex_read_bytes.sum,dram__bytes_read.sum,dram__bytes_write.sum)
+  profile_run() {  # file name, kernel regex, then deformlab run's arguments (at least 21 launches of the kernel)
+    local name=$1 kernel=$2; shift 2
+    ncu --log-file "$out/ncu-$name.txt" --kernel-id "::regex:$kernel:21" "${sections[@]}" "$app" run \
+      --experiment table2 --grid 2048x2048 --no-state --out /tmp/ncu-run "$@" >/dev/null 2>&1
+  }
+  for math in exact fast; do
+    for integ in explicit-euler semi-implicit-euler verlet; do
+      profile_run "fused-$integ-$math" fused_ --pipeline cuda-fused --integrator "$integ" --option math=$math --steps 30
+    done
+  done
+  profile_run "fused-explicit-euler-exact-tma-off" fused_grid --pipeline cuda-fused --integrator explicit-euler \
+    --option math=exact --option tma=off --steps 30
+  for math in exact fast; do
+    profile_run "temporal-$math" temporal_grid --pipeline cuda-temporal --integrator semi-implicit-euler \
+      --option math=$math --steps 60 --check-every 4
+  done
+  for p in cuda-naive cuda-tiled; do
+    profile_run "$p-force" force_grid --pipeline $p --integrator explicit-euler --option math=exact --steps 30
+  done
+  ncu --log-file "$out/ncu-bare-gather.txt" --kernel-name-base demangled --kernel-id "::regex:bare_gather:21" \
+    "${sections[@]}" "$bench" cuda --sizes 2048 --variants fused --tiles 32x8 --tile-size 2048 --graph-sizes 64 \
+    --temporal-sizes 0 >/dev/null 2>&1
+  summary+=("profile: $(grep -l 'smsp__inst_executed.sum' "$out"/ncu-*.txt | wc -l) Nsight Compute reports ($out/ncu-*.txt)")
 fi
 
 if part experiments; then
