@@ -109,7 +109,7 @@ OutputDir::~OutputDir() {
   if (created_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
 }
 
-void OutputDir::commit() {
+void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
   std::vector<std::string> staged;
   for (const auto& e : fs::directory_iterator(staging_))
     staged.push_back(e.path().filename().string() + (e.is_directory() ? "/" : ""));
@@ -129,6 +129,7 @@ void OutputDir::commit() {
     const fs::path target = dir_ / e.path().filename();
     if (fs::is_directory(e.path()) && fs::exists(target)) fs::remove_all(target);
     fs::rename(e.path(), target);
+    if (moved) moved(target);
   }
   if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
 }

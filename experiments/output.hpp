@@ -4,6 +4,7 @@
 // with a manifest. Temporaries of killed processes are reclaimed by the next one.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -55,8 +56,9 @@ class OutputDir {
   // the old manifest.json is removed first, then the old output's files the new one lacks, and
   // the new manifest is moved in last. Where an entry of the other kind (file or folder) has
   // appeared in the way since, throws std::runtime_error with the folder as it was and the
-  // outputs moved to `dir`/unsaved-run-<pid>.
-  void commit();
+  // outputs moved to `dir`/unsaved-run-<pid>. `moved`, where given, is called after each
+  // entry but the manifest is moved into place, with its new path (a test stops a commit there).
+  void commit(const std::function<void(const std::filesystem::path&)>& moved = {});
   const std::filesystem::path& dir() const { return dir_; }
 
  private:

@@ -72,19 +72,24 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
 
 TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesIt) {
   const fs::path dir = fresh("deformlab-commit-stopped");
-  // What a commit stopped after its first rename leaves: the old manifest removed, one new
-  // output in place, the rest still in its staging folder (whose process is gone).
-  write(dir / "summary.txt", "new");
-  write(dir / "state.ply", "old");
-  fs::create_directories(dir / ".staging-999999999");
-  write(dir / ".staging-999999999" / "state.ply", "new");
-  write(dir / ".staging-999999999" / "manifest.json", "new");
+  for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(dir / f, "old");
+  // A process that stops for good after its commit's first rename (as if killed there).
+  EXPECT_EXIT(
+      {
+        OutputDir out(dir, kOutputs);
+        for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "new");
+        out.commit([](const fs::path&) { ::_exit(3); });
+      },
+      testing::ExitedWithCode(3), "");
   EXPECT_EQ(folder_holds(dir), Holds::nothing) << "an incomplete folder has no manifest";
+  int moved = 0, staging = 0;
+  for (const char* f : {"summary.txt", "state.ply"}) moved += read(dir / f) == "new";
+  for (const auto& e : fs::directory_iterator(dir)) staging += e.path().filename().string().starts_with(".staging-");
+  EXPECT_EQ(moved, 1) << "one output moved in before the stop";
+  EXPECT_EQ(staging, 1) << "the stopped process's staging folder";
   {
     OutputDir out(dir, kOutputs);
-    write(out.staged("summary.txt"), "newer");
-    write(out.staged("state.ply"), "newer");
-    write(out.staged("manifest.json"), "newer");
+    for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "newer");
     out.commit();
   }
   for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "newer") << f;
