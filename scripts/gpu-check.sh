@@ -118,8 +118,9 @@ if part speed; then
 fi
 
 # Nsight Compute on table2's scene at 2048^2 (its default clock control: the SM clock locked at
-# base): cuda-fused in both maths and integrators, cuda-temporal, the bare gather (the bench's,
-# each of its kernels at its 21st launch), and the force passes of cuda-naive and cuda-tiled.
+# base): cuda-fused in both maths and its three one-pass integrators, cuda-temporal, the bare
+# gather (the bench's, each of its kernels at its 21st launch), and the force passes of
+# cuda-naive and cuda-tiled.
 # Beside the sections, the counts behind the bounds in docs/speed.md: warp instructions (at most
 # one a scheduler and cycle) and L1 data-pipe wavefronts (at most one an SM and cycle). The
 # programs' own output is dropped: their timings under the profiler are not the kernels'.
@@ -149,7 +150,7 @@ if part profile && command -v ncu >/dev/null; then
   ncu --log-file "$out/ncu-bare-gather.txt" --kernel-name-base demangled --kernel-id "::regex:bare_gather:21" \
     "${sections[@]}" "$bench" cuda --sizes 2048 --variants fused --tiles 32x8 --tile-size 2048 --graph-sizes 64 \
     --temporal-sizes 0 >/dev/null 2>&1
-  summary+=("profile: $(grep -l 'smsp__inst_executed.sum' "$out"/ncu-*.txt | wc -l) Nsight Compute reports ($out/ncu-*.txt)")
+  summary+=("profile: $(cat "$out"/ncu-*.txt | grep -c 'smsp__inst_executed.sum') kernels profiled ($out/ncu-*.txt)")
 fi
 
 if part experiments; then
