@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
 
   auto* run = cli.add_subcommand("run", "Run an experiment (with no options: the paper's drag experiment)");
   run->add_option("--experiment", a.experiment, "Experiment file or built-in name, e.g. table2 (default: paper-drag)");
-  run->add_option("--scene", a.scene, "Scene file overriding the experiment's scene");
+  run->add_option("--scene", a.scene, "Scene file in place of the experiment's scene (absent keys: the defaults)");
   run->add_option("--pipeline,-p", a.pipeline, "Pipeline name ('deformlab list'), or 'best'");
   run->add_option("--integrator,-i", a.integrator, "Integrator name ('deformlab list')");
   auto* grid = run->add_option("--grid", a.grid, "Cloth grid size WxH, e.g. 128x128");
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   v.run.argv = a.argv;
   auto* view = cli.add_subcommand("view", "Open the simulation in a window: pick and drag nodes, switch stages live");
   view->add_option("--experiment", v.run.experiment, "Experiment file or built-in name (default: paper-drag)");
-  view->add_option("--scene", v.run.scene, "Scene file overriding the experiment's scene");
+  view->add_option("--scene", v.run.scene, "Scene file in place of the experiment's scene (absent keys: the defaults)");
   view->add_option("--pipeline,-p", v.run.pipeline, "Pipeline name ('deformlab list'), or 'best'");
   view->add_option("--integrator,-i", v.run.integrator, "Integrator name ('deformlab list')");
   auto* view_grid = view->add_option("--grid", v.run.grid, "Cloth grid size WxH, e.g. 128x128");
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
   deformlab::app::MeshArgs mesh_args;
   auto* mesh = cli.add_subcommand("mesh", "Write the mesh a scene generates (its model's \"generate\") to a Gmsh .msh file");
   mesh->add_option("--experiment", mesh_args.experiment, "Experiment file or built-in name (default: paper-drag)");
-  mesh->add_option("--scene", mesh_args.scene, "Scene file overriding the experiment's scene");
+  mesh->add_option("--scene", mesh_args.scene, "Scene file in place of the experiment's scene (absent keys: the defaults)");
   mesh->add_option("--model", mesh_args.model, "One of the mesh models the experiment's sweep names");
   mesh->add_option("--out,-o", mesh_args.out, "The .msh file to write")->required();
 

@@ -180,8 +180,10 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   const Model& m = in.model;
   const RunResult& r = ran.result;
   const WarmUp& warm = ran.warm_up;
-  std::cout << "deformlab run: " << (in.x.name.empty() ? "scene" : in.x.name)
-            << (a.scene ? " with scene " + *a.scene : std::string()) << " on " << in.entry->name << " ("
+  const std::string experiment = in.x.name.empty() ? "the experiment's" : in.x.name + "'s";
+  std::cout << "deformlab run: "
+            << (a.scene ? "scene " + *a.scene + " (in place of " + experiment + ")" : in.x.name.empty() ? "scene" : in.x.name)
+            << " on " << in.entry->name << " ("
             << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
             << m.spring_count() << " springs\n";
   for (const auto& [name, value] : pipe.chosen_options())
