@@ -275,8 +275,14 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     m.ny = integer(s[1], where + ".size[1]", 1);
     m.nz = want == 3 ? integer(s[2], where + ".size[2]", 1) : 1;
   }
-  if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);  // 0: from width
-  if (j.contains("width")) m.width = num(j["width"], where + ".width", Range::positive);
+  // A layer gives the spacing or the width (spacing 0: width / (nx - 1)), and replaces the other.
+  if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);
+  if (j.contains("width")) {
+    if (m.spacing > 0 && j.contains("spacing"))
+      bad(where + ".width", "give spacing or width, not both (the width is (nx - 1) x spacing)");
+    m.width = num(j["width"], where + ".width", Range::positive);
+    m.spacing = 0;
+  }
   if (j.contains("height")) m.height = num(j["height"], where + ".height");
   if (j.contains("node_mass")) m.material.node_mass = num(j["node_mass"], where + ".node_mass", Range::positive);
   if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness", Range::positive);
@@ -468,8 +474,9 @@ json to_json(const Scene& s) {
     }
     if (ms.density > 0) model["density"] = ms.density;
   } else {
-    model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"spacing", m.spacing},
-                  {"width", m.width}, {"height", m.height}});
+    model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"height", m.height}});
+    if (m.spacing > 0) model["spacing"] = m.spacing;  // the width it sets is (nx - 1) x spacing
+    else model["width"] = m.width;
     model["size"] = m.topology == Topology::lattice ? json::array({m.nx, m.ny, m.nz}) : json::array({m.nx, m.ny});
   }
   switch (m.pins) {

@@ -117,6 +117,8 @@ const std::vector<BadInput>& cases() {
       scene("mass_negative", "{\"model\": {\"node_mass\": -1}}", "s.json.model.node_mass: expected a number > 0"),
       scene("width_negative", "{\"model\": {\"width\": -1}}", "s.json.model.width: expected a number > 0"),
       scene("spacing_negative", "{\"model\": {\"spacing\": -0.1}}", "s.json.model.spacing: expected a number >= 0"),
+      scene("spacing_and_width", "{\"model\": {\"spacing\": 0.1, \"width\": 2}}",
+            "s.json.model.width: give spacing or width, not both"),
       scene("pins_duplicate", "{\"model\": {\"pins\": [0, 0]}}", "s.json.model.pins[1]: node 0 is listed twice"),
       scene("pins_negative", "{\"model\": {\"pins\": [-1]}}", "s.json.model.pins[0]: expected an integer >= 0"),
       scene("pins_outside", "{\"model\": {\"size\": [8, 8], \"pins\": [99999]}}", "s.json.model.pins[0]: node 99999 is outside the model (0..63)"),

@@ -70,6 +70,23 @@ TEST(Scene, ReadsEveryKeyAndRoundTrips) {
   EXPECT_EQ(resolve_params(t, m).drag.path[0].position, (Vec3f{1, 2, 3}));
 }
 
+// A layer gives a grid's spacing or its width and replaces the other; the scene as recorded
+// names the one that sets the spacing.
+TEST(Scene, ALayersSpacingOrWidthReplacesTheOther) {
+  Scene s;
+  apply_json(s, json::parse(R"({"model": {"size": [5, 3], "spacing": 0.1}})"), "a");
+  EXPECT_NEAR(build_model(s).rest_position[4].x - build_model(s).rest_position[0].x, 0.4f, 1e-6f);
+  EXPECT_EQ(to_json(s)["model"].count("width"), 0u);
+  apply_json(s, json::parse(R"({"model": {"width": 2}})"), "b");
+  EXPECT_NEAR(build_model(s).rest_position[4].x - build_model(s).rest_position[0].x, 2.f, 1e-6f);
+  EXPECT_EQ(to_json(s)["model"].count("spacing"), 0u);
+  apply_json(s, json::parse(R"({"model": {"spacing": 0.25}})"), "c");
+  EXPECT_NEAR(build_model(s).rest_position[4].x - build_model(s).rest_position[0].x, 1.f, 1e-6f);
+  Scene t;
+  apply_json(t, to_json(s), "t");
+  EXPECT_EQ(to_json(t), to_json(s));
+}
+
 TEST(Scene, ErrorsNameTheKey) {
   EXPECT_NE(error_of(R"({"scene": {"dtt": 1}})").find("x.json.scene.dtt: unknown key"), std::string::npos);
   EXPECT_NE(error_of(R"({"scene": {"dt": "fast"}})").find("x.json.scene.dt: expected a number"), std::string::npos);
