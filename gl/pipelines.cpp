@@ -17,7 +17,11 @@ void add_gl_pipelines(PipelineRegistry& r, const gl::CudaMemory& cuda) {
   };
   // Deterministic, and equal to the CPU within rounding (the GPU's arithmetic differs).
   auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
-  auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) { return gl::footprint(m, i, false); };
+  auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) {
+    Footprint f = gl::footprint(m, i, false);
+    if (gl::context_created() && gl::context().software) f.host += f.device;  // its buffers are host memory
+    return f;
+  };
   // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows); "link_view":
   // links per texture-buffer view of a mesh's adjacency; "math": exact or fast; "memory": gl or cuda.
   r.add({"glsl-compute", "GLSL compute shaders over storage buffers", on(Engine::gl_compute), unavailable,

@@ -3,6 +3,7 @@
 // error (exit 2).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/memory.hpp"
 #include "gl_test_support.hpp"
 #include "gl/objects.hpp"
 
@@ -109,6 +111,29 @@ TEST(GlErrors, BadOptionValuesAreBadInput) {
       std::filesystem::remove_all(dir);
     }
   }
+}
+
+// On a software renderer the GL buffers are host memory: a grid whose model and state fit but
+// whose buffers would not is refused with the host-memory check, before the model is built.
+TEST(GlErrors, ASoftwareRenderersBuffersAreCountedBeforeTheModelIsBuilt) {
+  DEFORMLAB_REQUIRE_GL();
+  if (!gl::context().software) GTEST_SKIP() << "a GPU's GL buffers are checked against its own memory";
+  const auto limit = host_memory_limit();
+  ASSERT_TRUE(limit.has_value());
+  // A node takes 52 bytes of host memory without the buffers and 116 with them (semi-implicit
+  // Euler's four node buffers): at limit / 80 nodes, 0.65 and 1.45 of the limit.
+  const int side = int(std::sqrt(double(limit->bytes) / 80));
+  const std::string grid = std::to_string(side) + "x" + std::to_string(side);
+  const auto dir = temp_dir("gl-memory");
+  const Command c = run_deformlab("", "run -p glsl-tf --integrator semi-implicit-euler --grid " + grid +
+                                          " --steps 1 --no-state -o '" + (dir / "out").string() + "'");
+  EXPECT_EQ(c.exit_code, 2) << c.output;
+  EXPECT_TRUE(c.output.starts_with("deformlab: error: a model of " + std::to_string(std::int64_t(side) * side) +
+                                   " nodes on glsl-tf needs "))
+      << c.output;
+  EXPECT_NE(c.output.find(" of host memory (model "), std::string::npos) << c.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
+  std::filesystem::remove_all(dir);
 }
 
 // The command end to end: frames every N steps and the final one, committed with the run;
