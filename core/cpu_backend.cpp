@@ -232,6 +232,10 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper> cg;
     cg.setTolerance(std::is_same_v<Real, double> ? Real(1e-10) : Real(1e-6));
     cg.setMaxIterations(std::max(100, 3 * n));
+    // Eigen's sparse products take its own thread count (all of OpenMP's unless set): this
+    // pipeline's, so that cpu solves on one thread. Each row is one thread's, so any count gives
+    // the same bits.
+    Eigen::setNbThreads(threads_);
     cg.compute(A);
     const Vec dv = cg.solve(rhs);
     if (cg.info() != Eigen::Success && !(cg.error() < 1e-3))

@@ -1,7 +1,8 @@
 // Physics against analytic solutions: a spring oscillator, free fall, energy behaviour of
-// each integrator, and backward Euler past the explicit stability limit.
+// each integrator, and backward Euler past the explicit stability limit, solved on one thread on cpu.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <cmath>
 #include <numbers>
 
@@ -195,6 +196,16 @@ TEST(Energy, SymplecticSchemesBoundedExplicitEulerGrows) {
   EXPECT_LT(energy_drift(Integrator::verlet, 10000, &ratio), 0.02);
   energy_drift(Integrator::explicit_euler, 10000, &ratio);
   EXPECT_GT(ratio, 1.2) << "explicit Euler should gain energy";
+}
+
+TEST(BackwardEuler, TheCpuPipelineSolvesOnOneThread) {
+  // Eigen's solver threads are a process-wide setting: omp's solve first, then cpu's.
+  const Model m = test::small_cloth(64, 64);
+  Params p = test::small_params();
+  p.max_steps = 1;
+  run(*make_cpu_pipeline({m, p, Integrator::backward_euler}, Precision::f32, true), m, p, {});
+  run(*make_cpu_pipeline({m, p, Integrator::backward_euler}, Precision::f32, false), m, p, {});
+  EXPECT_EQ(Eigen::nbThreads(), 1) << "the single-threaded pipeline's solve runs on one thread";
 }
 
 TEST(BackwardEuler, StableAtTenTimesTheExplicitLimit) {
