@@ -14,6 +14,9 @@ int report_errors(const std::function<int()>& body) {
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {  // a size the checks before allocating did not refuse
+    std::cerr << "deformlab: error: out of host memory: the model or its outputs do not fit this machine\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 1;
@@ -46,7 +49,7 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
   run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1023));
   run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");
   run->add_option("--warmup-ms", a.warmup_ms,
                   "Untimed steps from rest for at least this long before the run, which then starts from rest "

@@ -1,11 +1,13 @@
 #include "run_input.hpp"
 
 #include <sys/statvfs.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -87,7 +89,11 @@ void apply_model_flags(const RunArgs& a, ModelSpec& ms) {
 
 void apply_param_flags(const RunArgs& a, Params& p) {
   if (a.dt) p.dt = float(*a.dt);
-  if (a.dt && !(std::isfinite(*a.dt) && *a.dt > 0)) throw BadInput("--dt must be a positive finite number of seconds");
+  // Read as floats: a dt under float's normal range is 0 or a subnormal whose inverse overflows.
+  if (a.dt && !(*a.dt >= std::numeric_limits<float>::min() && *a.dt <= 3e38))
+    throw BadInput("--dt must be a positive number of seconds from 1.18e-38 (the smallest normal float) to 3e38");
+  if (a.threshold && !(std::isfinite(*a.threshold) && *a.threshold > 0 && *a.threshold <= 3e38))
+    throw BadInput("--threshold must be a positive finite number of metres");
   if (a.threshold) p.threshold = float(*a.threshold);
   if (a.check_every) p.check_every = *a.check_every;
   if (a.steps) p.max_steps = *a.steps;
@@ -149,12 +155,14 @@ void check_disk_fits(const RunArgs& a, const RunInput& in) {
   std::error_code ec;
   fs::path at = fs::absolute(in.out, ec);
   while (!fs::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
+  const std::string folder = "output folder '" + in.out.string() + "'";
+  if (::access(at.c_str(), W_OK) != 0) throw BadInput(folder + ": '" + at.string() + "' is not writable");
   struct statvfs v{};
   if (::statvfs(at.c_str(), &v) != 0) return;
+  if (v.f_blocks == 0) throw BadInput(folder + ": '" + at.string() + "' is on a file system that stores no files");
   const std::int64_t free = std::int64_t(v.f_bavail) * std::int64_t(v.f_frsize);
   const Params& p = in.params;
   const auto [need, what] = output_bytes(a, in, in.until_converged ? std::min(p.min_steps, p.max_steps) : p.max_steps);
-  const std::string folder = "output folder '" + in.out.string() + "'";
   if (need > free)
     throw BadInput(folder + ": this run writes " + (in.until_converged ? "at least " : "about ") + bytes_text(need) +
                    " (" + what + ") and its file system has " + bytes_text(free) + " free: free some or give another --out");
@@ -200,6 +208,9 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
+  if (const Params& p = in.x.scene.params; in.until_converged && a.steps && p.max_steps < p.min_steps)
+    throw BadInput("--steps " + std::to_string(p.max_steps) + " with --until-converged: the stop rule starts at the "
+                   "scene's min_steps (" + std::to_string(p.min_steps) + "), so give at least that many steps");
   check_records_fit(in.x.scene.params);
   if (a.compare && *a.compare != "reference")
     throw BadInput("--compare '" + *a.compare +

@@ -43,7 +43,8 @@ enum class Range { any, positive, non_negative };
 float num(const json& j, const std::string& where, Range r = Range::any) {
   if (!j.is_number()) bad(where, "expected a number");
   const double d = j.get<double>();
-  if (!std::isfinite(d) || std::abs(d) > 3.0e38) bad(where, "expected a finite number");
+  if (!std::isfinite(d)) bad(where, "expected a finite number");
+  if (std::abs(d) > 3.0e38) bad(where, "out of the float range (at most 3e38 in magnitude)");
   if (r == Range::positive && !(d > 0)) bad(where, "expected a number > 0");
   if (r == Range::non_negative && !(d >= 0)) bad(where, "expected a number >= 0");
   // Read as float: a size, mass or constant under float's normal range would be 0 or a
@@ -335,7 +336,8 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
     for (std::size_t k = 0; k < p.size(); ++k) {
       const std::string w = where + ".path[" + std::to_string(k) + "]";
       if (!p[k].is_array() || p[k].size() != 4) bad(w, "expected [t, x, y, z]");
-      h.path.push_back({num(p[k][0], w + "[0]"), {num(p[k][1], w + "[1]"), num(p[k][2], w + "[2]"), num(p[k][3], w + "[3]")}});
+      h.path.push_back({num(p[k][0], w + "[0]", Range::non_negative),
+                        {num(p[k][1], w + "[1]"), num(p[k][2], w + "[2]"), num(p[k][3], w + "[3]")}});
       if (k > 0 && !(h.path[k].t > h.path[k - 1].t)) bad(w + "[0]", "keyframe times must increase");
     }
   }

@@ -158,7 +158,10 @@ Mesh read_gmsh_model(const std::string& what) {
 
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) bad(path, "no such file");
+  const auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) bad(path, "no such file");
+  if (std::filesystem::is_directory(st)) bad(path, "a directory, not a mesh file");
+  if (!std::filesystem::is_regular_file(st)) bad(path, "not a regular file");
   const auto size = std::filesystem::file_size(path, ec);
   if (size == 0) bad(path, "the file is empty");
   const std::string what = "mesh file '" + path + "'";
