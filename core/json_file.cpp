@@ -2,16 +2,29 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace deformlab {
 
 namespace fs = std::filesystem;
 
 nlohmann::json parse_json(const std::string& text, const std::string& source) {
+  // The keys of each object still open, innermost last: a key given twice in one object is
+  // refused, where the library would keep the last.
+  std::vector<std::set<std::string>> open;
+  auto once = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start) open.emplace_back();
+    if (event == Event::object_end) open.pop_back();
+    if (event == Event::key && !open.back().insert(parsed.get<std::string>()).second)
+      throw std::invalid_argument(source + " gives the key '" + parsed.get<std::string>() + "' twice in one object");
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text, once);
   } catch (const nlohmann::json::exception& e) {
     // The library's text without its "[json.exception.parse_error.101] " tag.
     std::string why = e.what();

@@ -23,11 +23,13 @@ BadInput scene(const char* name, const std::string& json, const std::string& key
   return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", json}}};
 }
 
-// A scene with a mesh model (`model` holds its other keys) beside a mesh file `name` holding
-// `text` (an open triangle unless given).
+// A scene with a mesh model (`model` holds its other keys; pins none unless it gives them)
+// beside a mesh file `name` holding `text` (an open triangle unless given).
 BadInput mesh(const char* name, const std::string& model, const std::string& key,
               const std::string& text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", const std::string& file = "m.obj") {
-  const std::string scene = "{\"model\": {\"type\": \"mesh\", \"pins\": \"none\", " + model.substr(1) + "}";
+  const bool pins = model.find("\"pins\"") != std::string::npos;  // else none: a JSON key is given once
+  const std::string scene =
+      "{\"model\": {\"type\": \"mesh\", " + std::string(pins ? "" : "\"pins\": \"none\", ") + model.substr(1) + "}";
   return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", scene}, {file, text}}};
 }
 
@@ -93,6 +95,8 @@ const std::vector<BadInput>& cases() {
       {"scene_truncated", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", "{\"dt\": "}}},
       {"scene_overflow", "run --scene {dir}/s.json", "is not valid JSON: number overflow parsing '1e999'",
        {{"s.json", "{\"dt\": 1e999}"}}},
+      {"scene_duplicate_key", "run --scene {dir}/s.json", "s.json' gives the key 'dt' twice in one object",
+       {{"s.json", "{\"model\": {\"size\": [4, 4]}, \"dt\": 0.003, \"dt\": 0.001}"}}},
       // scene values
       scene("unknown_key", "{\"dtt\": 1}", "s.json.dtt: unknown key"),
       scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
