@@ -39,7 +39,12 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       Open() { ++bases_open; }
       ~Open() { --bases_open; }
     } open;
-    const Experiment b = load_experiment_by_name(j["base"].get<std::string>());
+    Experiment b;
+    try {
+      b = load_experiment_by_name(j["base"].get<std::string>());
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(where + ".base: " + e.what());
+    }
     x.pipeline = b.pipeline;
     x.integrator = b.integrator;
     x.until_converged = b.until_converged;

@@ -112,12 +112,14 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   if (s.sizes.empty() == s.models.empty()) bad(w, "needs either sizes or models");
   if (!s.orders.empty() && s.models.empty()) bad(w + ".orders", "node orders go with models");
   if (s.pipelines.empty()) bad(w, "needs pipelines");
+  // Without its own list the sweep takes the experiment's integrator, and an error names that key.
+  const std::string integrators_key = s.integrators.empty() ? where + ".integrator" : w + ".integrators";
   if (s.integrators.empty()) s.integrators = {x.value("integrator", std::string("semi-implicit-euler"))};
   if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};
   for (const auto& p : s.pipelines)
     if (!pipelines().find(p)) bad(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
   for (const auto& i : s.integrators)
-    if (!parse_integrator(i)) bad(w + ".integrators", "unknown integrator '" + i + "' (valid: " + integrator_names() + ")");
+    if (!parse_integrator(i)) bad(integrators_key, "unknown integrator '" + i + "' (valid: " + integrator_names() + ")");
   for (const auto& o : s.option_sets)
     for (const auto& [name, value] : o) {
       const bool read = std::any_of(s.pipelines.begin(), s.pipelines.end(), [&, &name = name](const std::string& p) {
