@@ -221,6 +221,9 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   const auto t0 = std::chrono::steady_clock::now();
   in.model = build_model(in.x.scene);
   if (mesh) check_fits(in, bool(a.compare), in.model.size());
+  if (in.model.grid() && in.options.count("link_view"))
+    throw BadInput("--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and this "
+                   "model is a grid");
   in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);
   if (output == Output::folder) check_disk_fits(a, in);

@@ -91,14 +91,16 @@ TEST(GlErrors, UnknownGlDeviceIsBadInput) {
 }
 
 // A pipeline option's bad value is bad input like the flags' (tests/unit/bad_input_test.cpp,
-// which runs without GL): one line, exit 2, nothing written. So is memory=cuda on a software
-// renderer, which has no CUDA device behind it.
+// which runs without GL): one line, exit 2, nothing written. So are a mesh's option on a grid
+// and memory=cuda on a software renderer, which has no CUDA device behind it.
 TEST(GlErrors, BadOptionValuesAreBadInput) {
   DEFORMLAB_REQUIRE_GL();
   for (const char* name : {"glsl-tf", "glsl-compute"}) {
     std::vector<std::pair<std::string, std::string>> cases = {
         {"math=foo", std::string(name) + ": option math 'foo' is not exact or fast\n"},
-        {"memory=host", std::string(name) + ": option memory 'host' is not one of gl, cuda\n"}};
+        {"memory=host", std::string(name) + ": option memory 'host' is not one of gl, cuda\n"},
+        {"link_view=4", "--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and "
+                        "this model is a grid\n"}};
     if (gl::context().software) cases.push_back({"memory=cuda", std::string(name) + ": memory cuda is not available: "});
     for (const auto& [option, error] : cases) {
       const auto dir = temp_dir("option");
