@@ -1,6 +1,8 @@
 #include "scene.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -451,6 +453,22 @@ std::string describe(const ModelSpec& m) {
   return "mesh " + m.mesh.file + (m.mesh.fill ? " filled with tetrahedra" : "") + order;
 }
 
+namespace {
+
+// Every number of `j` that is a float's value written as that float's shortest decimal (0.002,
+// not the double 0.0020000000949949026), which reads back as the same float.
+void shortest_floats(json& j) {
+  if (j.is_structured()) {
+    for (auto& v : j) shortest_floats(v);
+  } else if (j.is_number_float() && double(float(j.get<double>())) == j.get<double>()) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, float(j.get<double>())).ptr;
+    j = std::strtod(std::string(text, end).c_str(), nullptr);
+  }
+}
+
+}  // namespace
+
 json to_json(const Scene& s) {
   auto v3 = [](const Vec3f& v) { return json::array({v.x, v.y, v.z}); };
   auto kinds = [](const std::array<float, kSpringKinds>& a) {
@@ -505,6 +523,7 @@ json to_json(const Scene& s) {
   } else {
     j["drag"] = nullptr;
   }
+  shortest_floats(j);
   return j;
 }
 

@@ -132,7 +132,7 @@ TEST(GeneratedMesh, TakesTheSamePathAsAFile) {
   Scene t;
   apply_json(t, to_json(sc), "t");
   EXPECT_EQ(to_json(t), to_json(sc));
-  EXPECT_EQ(to_json(sc)["model"]["generate"]["size"], json::array({0.1f, 0.1f, 0.1f}));
+  EXPECT_EQ(to_json(sc)["model"]["generate"]["size"], json::array({0.1, 0.1, 0.1}));  // as the file gave it
   EXPECT_EQ(to_json(sc)["model"]["generate"]["threads"], 1);
 }
 

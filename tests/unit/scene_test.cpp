@@ -62,6 +62,9 @@ TEST(Scene, ReadsEveryKeyAndRoundTrips) {
   EXPECT_EQ(*s.params.ground, -2.f);
   EXPECT_TRUE(s.params.drag.as_spring);
   EXPECT_EQ(s.params.check_every, 4);
+  // Written as the floats' shortest decimals, as the file gave them.
+  EXPECT_EQ(to_json(s)["dt"].get<double>(), 0.004);
+  EXPECT_EQ(to_json(s)["model"]["node_mass"].get<double>(), 0.02);
   Scene t;
   apply_json(t, to_json(s), "t");
   EXPECT_EQ(to_json(t), to_json(s));
