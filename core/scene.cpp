@@ -1,5 +1,7 @@
 #include "scene.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -7,6 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -28,7 +31,7 @@ constexpr double kSheetPerArea = 1.314, kSheetPerRim = 0.631, kBoxPerVolume = 0.
   throw std::invalid_argument(where + ": " + what);
 }
 
-void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> keys) {
+void only_keys(const json& j, const std::string& where, std::span<const char* const> keys) {
   if (!j.is_object()) bad(where, "expected an object");
   const std::set<std::string> ok(keys.begin(), keys.end());
   for (const auto& [k, v] : j.items())
@@ -38,6 +41,14 @@ void only_keys(const json& j, const std::string& where, std::initializer_list<co
       bad(where + "." + k, "unknown key (expected one of: " + list + ")");
     }
 }
+void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> keys) {
+  only_keys(j, where, std::span(keys.begin(), keys.size()));
+}
+
+// A scene object's keys.
+constexpr std::array<const char*, 13> kSceneKeys = {"model", "dt", "gravity", "damping", "wind", "ground", "spheres",
+                                                    "drag", "threshold", "min_steps", "max_steps", "check_every",
+                                                    "runaway_factor"};
 
 // What a number may be: any finite value, > 0 or >= 0.
 enum class Range { any, positive, non_negative };
@@ -352,8 +363,7 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
 }  // namespace
 
 void apply_json(Scene& s, const json& j, const std::string& where, const std::string& dir) {
-  only_keys(j, where, {"model", "dt", "gravity", "damping", "wind", "ground", "spheres", "drag", "threshold",
-                       "min_steps", "max_steps", "check_every", "runaway_factor"});
+  only_keys(j, where, kSceneKeys);
   Params& p = s.params;
   if (j.contains("model")) apply_model(s.model, j["model"], where + ".model", dir);
   if (j.contains("dt")) p.dt = num(j["dt"], where + ".dt", Range::positive);
@@ -388,6 +398,10 @@ void apply_json(Scene& s, const json& j, const std::string& where, const std::st
   if (j.contains("check_every")) p.check_every = integer(j["check_every"], where + ".check_every", 1);
   if (j.contains("runaway_factor"))
     p.runaway_factor = num(j["runaway_factor"], where + ".runaway_factor", Range::positive);
+}
+
+bool is_scene_key(const std::string& key) {
+  return std::find(kSceneKeys.begin(), kSceneKeys.end(), key) != kSceneKeys.end();
 }
 
 Scene load_scene(const std::string& path) {

@@ -78,6 +78,8 @@ struct Scene {
 // Fills `scene` from a JSON object (keys absent keep their current values). A relative mesh
 // file is taken relative to `dir` (the folder of the file that names it).
 void apply_json(Scene& scene, const nlohmann::json& j, const std::string& where, const std::string& dir = "");
+// Whether `key` is one of a scene object's keys.
+bool is_scene_key(const std::string& key);
 // Reads a scene file; throws std::invalid_argument with the file name and the problem.
 Scene load_scene(const std::string& path);
 

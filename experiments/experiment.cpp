@@ -70,7 +70,8 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
     else
       throw std::invalid_argument(where + "." + k +
                                   ": unknown key (expected name, description, pipeline, integrator, "
-                                  "until_converged, base, scene, sweep)");
+                                  "until_converged, base, scene, sweep)" +
+                                  (is_scene_key(k) ? "; a scene's key: give a scene file with --scene" : ""));
   }
   x.raw = j;
   return x;
