@@ -83,11 +83,11 @@ std::ofstream open_csv(const std::string& path, const char* header);
 struct StepOptions : BenchOptions {
   int reps = 0;
 };
-// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given; on a
-// GPU also --warmup-ms); `run` runs it.
+// Adds `name` with StepOptions' flags (default sizes, warm-up and timed steps as given, --reps
+// described by `reps_help`; on a GPU also --warmup-ms); `run` runs it.
 enum class Device { cpu, gpu };
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
-                    int reps, void (*run)(const StepOptions&), Device device);
+                    int reps, const char* reps_help, void (*run)(const StepOptions&), Device device);
 
 void add_cpu_bench(CLI::App& app);
 #if DEFORMLAB_HAVE_CUDA

@@ -4,6 +4,7 @@
 
 #include "bench.hpp"
 #include "core/cpu_backend.hpp"
+#include "experiments/pipelines.hpp"
 
 namespace deformlab::bench {
 
@@ -15,7 +16,7 @@ void run_cpu(const StepOptions& o) {
   std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
-            << o.reps << " timed steps; omp uses all hardware threads\n\n"
+            << o.reps << " timed steps; omp: " << pipelines().find("omp")->summary << "\n\n"
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
   std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms");
@@ -44,7 +45,7 @@ void add_cpu_bench(CLI::App& app) {
                  "cpu vs omp ms/step at 64^2 to 512^2 (the paper's Table 1 sizes; the paper ran explicit Euler: "
                  "--integrator explicit-euler)",
                  {64, 128, 256, 512},
-                 5, 30, run_cpu, Device::cpu);
+                 5, 30, "Timed steps", run_cpu, Device::cpu);
 }
 
 }  // namespace deformlab::bench

@@ -85,7 +85,7 @@ void run_draw(const StepOptions& o) {
 
 void add_draw_bench(CLI::App& app) {
   add_step_bench(app, "draw", "The viewer's frame: the state handed to the renderer and drawn, per route",
-                 {256, 1024, 2048}, 5, 30, run_draw, Device::gpu);
+                 {256, 1024, 2048}, 5, 30, "Timed frames", run_draw, Device::gpu);
 }
 
 }  // namespace deformlab::bench

@@ -220,7 +220,8 @@ void run_gl(const StepOptions& o) {
 
 void add_gl_bench(CLI::App& app) {
   add_step_bench(app, "gl", "glsl-tf and glsl-compute ms/step beside the pass-through transform feedback ceiling",
-                 {256, 512, 1024, 2048}, 10, 50, run_gl, Device::gpu);
+                 {256, 512, 1024, 2048}, 10, 50, "Timed steps at the least (more where they take under 200 ms)",
+                 run_gl, Device::gpu);
 }
 
 }  // namespace deformlab::bench

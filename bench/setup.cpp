@@ -116,15 +116,14 @@ std::ofstream open_csv(const std::string& path, const char* header) {
 }
 
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,
-                    int reps, void (*run)(const StepOptions&), Device device) {
+                    int reps, const char* reps_help, void (*run)(const StepOptions&), Device device) {
   auto o = std::make_shared<StepOptions>();
   o->sizes = std::move(sizes);
   o->warmup = warmup;
   o->reps = reps;
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
-  c->add_option("--reps", o->reps, "Timed steps (gl: at the least, more where they take under 200 ms)")
-      ->check(CLI::PositiveNumber);
+  c->add_option("--reps", o->reps, reps_help)->check(CLI::PositiveNumber);
   if (device == Device::gpu) add_warmup_ms(*c, *o);
   c->callback([o, run] { run(*o); });
 }
