@@ -51,7 +51,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   // Read first, checked for coordinates that are not finite, then processed: joining identical
   // vertices would otherwise merge a NaN vertex into another and hide it.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
-  if (!scene) bad(path, importer.GetErrorString());
+  if (!scene) bad(path, std::string("assimp: ") + importer.GetErrorString());
   for (unsigned k = 0; k < scene->mNumMeshes; ++k)
     for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
       if (const aiVector3D& p = scene->mMeshes[k]->mVertices[v];
@@ -60,7 +60,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
                                        aiProcess_SortByPType | aiProcess_ValidateDataStructure);
-  if (!scene) bad(path, importer.GetErrorString());
+  if (!scene) bad(path, std::string("assimp: ") + importer.GetErrorString());
   Mesh m;
   std::int64_t points = 0, lines = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {

@@ -153,7 +153,7 @@ const std::vector<BadInput>& cases() {
       mesh("mesh_file_missing", "{\"file\": \"none.obj\"}", "none.obj': no such file"),
       mesh("mesh_file_directory", "{\"file\": \"/\"}", "mesh file '/': a directory, not a mesh file"),
       mesh("mesh_file_empty", "{\"file\": \"m.obj\"}", "m.obj': the file is empty", ""),
-      mesh("mesh_file_truncated", "{\"file\": \"m.stl\"}", "m.stl': Failed to determine STL storage",
+      mesh("mesh_file_truncated", "{\"file\": \"m.stl\"}", "m.stl': assimp: Failed to determine STL storage",
            std::string(80, ' ') + std::string("\x0c\0\0\0", 4) + std::string(50, '\0'), "m.stl"),
       mesh("mesh_nan", "{\"file\": \"m.obj\"}", "m.obj': a vertex has a NaN or infinite coordinate (nan, 0, 0)",
            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
