@@ -72,7 +72,8 @@ int experiment_command(const ExperimentArgs& a) {
         std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
-          std::cout << ": " << std::setprecision(4) << r["median_ms"].get<double>() << " ms/step";
+          std::cout << ": " << std::setprecision(4) << r["median_ms"].get<double>() << " ms/step"
+                    << (p.kept ? " (kept)" : "");
         else
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
         std::cout << std::setprecision(3) << "  [" << p.elapsed_s << " s, about " << std::ceil(left) << " s left]"
@@ -80,7 +81,7 @@ int experiment_command(const ExperimentArgs& a) {
       };
       nlohmann::json command = a.argv;
       const int ran = run_sweep(x, *sweep, dir, o, command);
-      std::cout << "ran " << ran << " cells\n";
+      std::cout << "ran " << ran << " cells, kept " << int(cells(*sweep).size()) - ran << "\n";
     }
     std::cout << "report: " << write_report(dir).string() << "\n";
     return 0;

@@ -287,7 +287,8 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     const fs::path file = dir / "cells" / (c.id() + ".json");
     // A measured cell is done; an n/a one is tried again (the build or machine may differ).
     json r = fs::exists(file) ? read_cell(file) : json();  // a damaged cell file is redone
-    if (r.is_object() && r["status"] == "ok") {
+    prog.kept = r.is_object() && r["status"] == "ok";
+    if (prog.kept) {
       ++prog.skipped;
     } else {
       r = run_cell(x, s, c, cache);

@@ -55,6 +55,7 @@ std::vector<Cell> cells(const Sweep& s);
 struct SweepProgress {
   int done = 0, total = 0, skipped = 0;
   double elapsed_s = 0;
+  bool kept = false;  // this cell was measured before and kept, not run
 };
 
 struct SweepOptions {

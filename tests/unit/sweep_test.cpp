@@ -80,11 +80,17 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   for (const auto& r : results) na += r["status"] == "n/a";
   EXPECT_EQ(run_sweep(x, s, dir_, {}, json::array()), na);
   fs::remove(dir_ / "cells" / (Cell{6, "omp", "midpoint", {}}.id() + ".json"));
-  int seen_skipped = 0;
+  int seen_skipped = 0, seen_kept = 0;
   SweepOptions o;
-  o.on_cell = [&](const Cell&, const json&, const SweepProgress& p) { seen_skipped = p.skipped; };
+  o.on_cell = [&](const Cell& c, const json& r, const SweepProgress& p) {
+    seen_skipped = p.skipped;
+    seen_kept += p.kept;
+    const bool redone = c.id() == Cell{6, "omp", "midpoint", {}}.id();
+    EXPECT_EQ(p.kept, r["status"] == "ok" && !redone) << c.id();
+  };
   EXPECT_EQ(run_sweep(x, s, dir_, o, json::array()), 1 + na);
   EXPECT_EQ(seen_skipped, 7 - na);
+  EXPECT_EQ(seen_kept, 7 - na) << "each kept cell is marked so";
   for (const auto& f : fs::recursive_directory_iterator(dir_))
     EXPECT_EQ(f.path().string().find(".tmp-"), std::string::npos) << f.path();
   // Frames of the drag for the report: rendered once (kept on resume), or the reason why not.
