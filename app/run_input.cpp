@@ -208,6 +208,9 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
+  if (a.threshold && !in.until_converged)
+    throw BadInput("--threshold applies to a run until converged (--until-converged); this one takes a fixed number "
+                   "of steps");
   if (const Params& p = in.x.scene.params; in.until_converged && a.steps && p.max_steps < p.min_steps)
     throw BadInput("--steps " + std::to_string(p.max_steps) + " with --until-converged: the stop rule starts at the "
                    "scene's min_steps (" + std::to_string(p.min_steps) + "), so give at least that many steps");

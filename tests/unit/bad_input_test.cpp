@@ -71,6 +71,8 @@ const std::vector<BadInput>& cases() {
       {"warmup_letters", "run --warmup-ms abc", "--warmup-ms"},
       {"threshold_zero", "run --pipeline cpu --threshold 0", "threshold"},
       {"threshold_inf", "run --pipeline cpu --threshold inf", "--threshold must be a positive finite number of metres"},
+      {"threshold_without_convergence", "run --pipeline cpu --steps 5 --threshold 0.01",
+       "--threshold applies to a run until converged (--until-converged); this one takes a fixed number of steps"},
       {"steps_under_min_steps", "run --pipeline cpu --until-converged --steps 50",
        "--steps 50 with --until-converged: the stop rule starts at the scene's min_steps (100)"},
       {"check_every_zero", "run --pipeline cpu --check-every 0", "check_every"},
