@@ -101,6 +101,17 @@ void write_setup(Report& r) {
   const json availability = r.manifest.value("pipelines", json::object());
   for (const auto& [p, status] : availability.items())
     if (status != "available") r.md << "- `" << p << "` not available: " << status.get<std::string>() << "\n";
+  // Grid sizes of the sweep without a cell yet (left out by --max-size, or not reached).
+  std::set<int> measured;
+  for (const auto& c : r.cells)
+    if (c.contains("size") && c["size"].is_number_integer()) measured.insert(c["size"].get<int>());
+  std::string missing;
+  for (const auto& n : xj.value("sweep", json::object()).value("sizes", json::array()))
+    if (n.is_number_integer() && !measured.count(n.get<int>()))
+      missing += (missing.empty() ? "" : ", ") + std::to_string(n.get<int>()) + "²";
+  if (!missing.empty())
+    r.md << "- Not measured yet: " << missing << " (left out by --max-size, or not reached; `deformlab experiment` "
+         << "on this folder again runs them and keeps the cells it has)\n";
 }
 
 // The GPU's clock over the cells' timed batches (cells with `sm_clock`).
