@@ -75,6 +75,10 @@ PipelineOptions parse_options(const std::vector<std::string>& flags, const Pipel
 }
 
 void apply_model_flags(const RunArgs& a, ModelSpec& ms) {
+  if ((a.grid || a.lattice) && ms.topology == Topology::general)
+    std::cerr << "deformlab: note: " << (a.grid ? "--grid " + *a.grid + " replaces the scene's mesh model with a cloth"
+                                                : "--lattice " + *a.lattice + " replaces the scene's mesh model with a lattice")
+              << "\n";
   if (a.grid) {
     const auto d = parse_size(*a.grid, 2, "--grid");
     ms.topology = Topology::cloth_grid;

@@ -212,6 +212,16 @@ TEST_F(Cli, LargeClothRunsWithinItsCountedMemory) {
   EXPECT_EQ(fs::file_size(out / "state.ply"), head.find("end_header\n") + 11 + nodes * 24 + 2 * 4095.0 * 4095.0 * 13);
 }
 
+TEST_F(Cli, GridFlagOnAMeshSceneSaysItReplacesTheMesh) {
+  write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write("s.json", R"({"model": {"type": "mesh", "file": "m.obj", "pins": "none"}})");
+  const Result r = run("run --pipeline cpu --scene " + (dir_ / "s.json").string() + " --grid 8x8 --steps 2 --out " +
+                       (dir_ / "g").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "deformlab: note: --grid 8x8 replaces the scene's mesh model with a cloth\n");
+  EXPECT_NE(r.out.find("cloth 8x8: 64 nodes"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, PapersAliasesAndLattices) {
   const Result r = run("run --pipeline omp --integrator implicit-euler --lattice 4x3x5 --steps 5 --out " +
                        (dir_ / "lat").string());
