@@ -1,6 +1,8 @@
 #include "run_input.hpp"
 
+#include <linux/magic.h>
 #include <sys/statvfs.h>
+#include <sys/vfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -154,16 +156,33 @@ std::pair<std::int64_t, std::string> output_bytes(const RunArgs& a, const RunInp
 // Refuses a run whose files would not fit in the free space of its output folder's file
 // system; a convergence run, which may stop at min_steps, only where those would not, with a
 // note where all its steps would not.
-void check_disk_fits(const RunArgs& a, const RunInput& in) {
-  namespace fs = std::filesystem;
+// The output folder, or the nearest folder above it that exists.
+std::filesystem::path existing_part(const std::filesystem::path& out) {
   std::error_code ec;
-  fs::path at = fs::absolute(in.out, ec);
-  while (!fs::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
-  const std::string folder = "output folder '" + in.out.string() + "'";
+  std::filesystem::path at = std::filesystem::absolute(out, ec);
+  while (!std::filesystem::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
+  return at;
+}
+
+// Refuses an output folder on one of the kernel's own file systems (proc, sysfs, ...), which
+// hold no files of ours, or where this process may not write.
+void require_writable(const std::filesystem::path& out) {
+  const std::filesystem::path at = existing_part(out);
+  const std::string folder = "output folder '" + out.string() + "'";
+  struct statfs f{};
+  constexpr long kKernelFileSystems[] = {PROC_SUPER_MAGIC, SYSFS_MAGIC,      CGROUP_SUPER_MAGIC, CGROUP2_SUPER_MAGIC,
+                                         DEBUGFS_MAGIC,    TRACEFS_MAGIC,    SECURITYFS_MAGIC,   PSTOREFS_MAGIC,
+                                         BPF_FS_MAGIC,     DEVPTS_SUPER_MAGIC};
+  if (::statfs(at.c_str(), &f) == 0 && std::ranges::find(kKernelFileSystems, long(f.f_type)) != std::end(kKernelFileSystems))
+    throw BadInput(folder + ": '" + at.string() + "' is on one of the kernel's file systems (such as proc or sysfs)");
   if (::access(at.c_str(), W_OK) != 0) throw BadInput(folder + ": '" + at.string() + "' is not writable");
+}
+
+void check_disk_fits(const RunArgs& a, const RunInput& in) {
+  const std::filesystem::path at = existing_part(in.out);
+  const std::string folder = "output folder '" + in.out.string() + "'";
   struct statvfs v{};
-  if (::statvfs(at.c_str(), &v) != 0) return;
-  if (v.f_blocks == 0) throw BadInput(folder + ": '" + at.string() + "' is on a file system that stores no files");
+  if (::statvfs(at.c_str(), &v) != 0 || v.f_blocks == 0) return;  // no size known (ramfs, some FUSE file systems)
   const std::int64_t free = std::int64_t(v.f_bavail) * std::int64_t(v.f_frsize);
   const Params& p = in.params;
   const auto [need, what] = output_bytes(a, in, in.until_converged ? std::min(p.min_steps, p.max_steps) : p.max_steps);
@@ -202,6 +221,7 @@ RunInput read_run_input(const RunArgs& a, Output output) {
     in.out = a.out ? *a.out : "runs/" + name + (in.x.raw.contains("sweep") ? "-run" : "");
     require_folder_or_nothing(in.out);
     require_holds_nothing_but(in.out, Holds::run);
+    require_writable(in.out);
   }
   const auto i = parse_integrator(in.x.integrator);
   if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");

@@ -87,7 +87,7 @@ const std::vector<BadInput>& cases() {
       {"lattice_too_large", "run --lattice 2000x2000x2000", "exceeds the limit of 2^30 nodes"},
       {"host_memory", "run --pipeline reference --grid 32000x32000", "GiB of host memory"},
       {"out_is_a_file", "run --pipeline cpu --steps 3 --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
-      {"out_no_storage", "run --pipeline cpu --steps 3 --out /proc/deformlab-out", "'/proc' is on a file system that stores no files"},
+      {"out_no_storage", "run --pipeline cpu --steps 3 --out /proc/deformlab-out", "'/proc' is on one of the kernel's file systems (such as proc or sysfs)"},
       // scene files that are no JSON file
       {"scene_missing", "run --scene {dir}/missing.json", "cannot open scene file"},
       {"scene_directory", "run --scene {dir}", "is a directory, not a JSON file"},
