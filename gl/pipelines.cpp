@@ -18,7 +18,7 @@ void add_gl_pipelines(PipelineRegistry& r, const gl::CudaMemory& cuda) {
   auto on = [](Engine e) { return PipelineTraits{e, e, true, CpuMatch::rounding}; };
   auto footprint = [](const ModelSize& m, Integrator i, const PipelineOptions&) {
     Footprint f = gl::footprint(m, i, false);
-    if (gl::context_created() && gl::context().software) f.host += f.device;  // its buffers are host memory
+    if (gl::context_created() && gl::context().software) f = {f.host + f.device, 0};  // its buffers are host memory
     return f;
   };
   // "window": nodes per storage-buffer window (gl/gl_pipeline.hpp, node_windows); "link_view":
