@@ -5,26 +5,82 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace deformlab {
 
 namespace fs = std::filesystem;
 
-nlohmann::json parse_json(const std::string& text, const std::string& source) {
-  // The keys of each object still open, innermost last: a key given twice in one object is
-  // refused, where the library would keep the last.
-  std::vector<std::set<std::string>> open;
-  auto once = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
-    using Event = nlohmann::json::parse_event_t;
-    if (event == Event::object_start) open.emplace_back();
-    if (event == Event::object_end) open.pop_back();
-    if (event == Event::key && !open.back().insert(parsed.get<std::string>()).second)
-      throw std::invalid_argument(source + " gives the key '" + parsed.get<std::string>() + "' twice in one object");
-    return true;
+namespace {
+
+// A pass over JSON text that finds a key given twice in one object (the library keeps the
+// last) and where that object is ("spheres[1]"): the keys of each object still open, and where
+// each open container sits in its parent.
+class DuplicateKey : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  std::string found;  // "'key' twice in one object (at path)", or empty
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return open(true); }
+  bool start_array(std::size_t) override { return open(false); }
+  bool end_object() override { return close(); }
+  bool end_array() override { return close(); }
+  bool key(string_t& k) override {
+    Frame& f = open_.back();
+    f.key = k;
+    if (f.keys.insert(k).second) return true;
+    std::string at;
+    for (std::size_t i = 0; i + 1 < open_.size(); ++i) {
+      if (!open_[i].object) {
+        at += '[';
+        at += std::to_string(open_[i].elements - 1);
+        at += ']';
+        continue;
+      }
+      if (!at.empty()) at += '.';
+      at += open_[i].key;
+    }
+    found = "'" + k + "' twice in one object" + (at.empty() ? "" : " (at " + at + ")");
+    return false;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys = {};
+    std::string key = {};       // an object's: the last key read
+    std::size_t elements = 0;   // an array's: values read so far
   };
+  bool value() {
+    if (!open_.empty() && !open_.back().object) ++open_.back().elements;
+    return true;
+  }
+  bool open(bool object) {
+    value();
+    open_.push_back({object});
+    return true;
+  }
+  bool close() {
+    open_.pop_back();
+    return true;
+  }
+  std::vector<Frame> open_;
+};
+
+}  // namespace
+
+nlohmann::json parse_json(const std::string& text, const std::string& source) {
+  nlohmann::json j;
   try {
-    return nlohmann::json::parse(text, once);
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     // The library's text without its "[json.exception.parse_error.101] " tag.
     std::string why = e.what();
@@ -32,6 +88,10 @@ nlohmann::json parse_json(const std::string& text, const std::string& source) {
       why.erase(0, end + 2);
     throw std::invalid_argument(source + " is not valid JSON: " + why);
   }
+  DuplicateKey twice;
+  nlohmann::json::sax_parse(text, &twice);
+  if (!twice.found.empty()) throw std::invalid_argument(source + " gives the key " + twice.found);
+  return j;
 }
 
 nlohmann::json read_json_file(const std::string& path, const std::string& what) {

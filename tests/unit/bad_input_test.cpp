@@ -99,6 +99,10 @@ const std::vector<BadInput>& cases() {
        {{"s.json", "{\"dt\": 1e999}"}}},
       {"scene_duplicate_key", "run --scene {dir}/s.json", "s.json' gives the key 'dt' twice in one object",
        {{"s.json", "{\"model\": {\"size\": [4, 4]}, \"dt\": 0.003, \"dt\": 0.001}"}}},
+      {"scene_duplicate_key_inside", "run --scene {dir}/s.json",
+       "s.json' gives the key 'radius' twice in one object (at spheres[1])",
+       {{"s.json", "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}, {\"center\": [0, 1, 0], \"radius\": 1, "
+                   "\"radius\": 2}]}"}}},
       // scene values
       scene("unknown_key", "{\"dtt\": 1}", "s.json.dtt: unknown key"),
       scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
