@@ -470,14 +470,18 @@ std::string describe(const ModelSpec& m) {
 namespace {
 
 // Every number of `j` that is a float's value written as that float's shortest decimal (0.002,
-// not the double 0.0020000000949949026), which reads back as the same float.
+// not the double 0.0020000000949949026), where that decimal reads back as the same float (read
+// as a double first, a few do not: those keep their exact value).
 void shortest_floats(json& j) {
   if (j.is_structured()) {
     for (auto& v : j) shortest_floats(v);
   } else if (j.is_number_float() && double(float(j.get<double>())) == j.get<double>()) {
+    const float f = float(j.get<double>());
     char text[32];
-    const auto end = std::to_chars(text, text + sizeof text, float(j.get<double>())).ptr;
-    j = std::strtod(std::string(text, end).c_str(), nullptr);
+    const auto end = std::to_chars(text, text + sizeof text, f).ptr;
+    double d = 0;
+    std::from_chars(text, end, d);
+    if (float(d) == f) j = d;
   }
 }
 

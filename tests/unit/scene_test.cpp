@@ -62,9 +62,13 @@ TEST(Scene, ReadsEveryKeyAndRoundTrips) {
   EXPECT_EQ(*s.params.ground, -2.f);
   EXPECT_TRUE(s.params.drag.as_spring);
   EXPECT_EQ(s.params.check_every, 4);
-  // Written as the floats' shortest decimals, as the file gave them.
+  // Written as the floats' shortest decimals, as the file gave them, where those read back as
+  // the same floats: 7.0385307e-26's, 7.038531e-26, read as a double, does not.
   EXPECT_EQ(to_json(s)["dt"].get<double>(), 0.004);
   EXPECT_EQ(to_json(s)["model"]["node_mass"].get<double>(), 0.02);
+  Scene w;
+  apply_json(w, json::parse(R"({"wind": [7.0385307e-26, 0, 0]})"), "w");
+  EXPECT_EQ(float(to_json(w)["wind"][0].get<double>()), w.params.wind.x);
   Scene t;
   apply_json(t, to_json(s), "t");
   EXPECT_EQ(to_json(t), to_json(s));
