@@ -42,8 +42,9 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
     Experiment b;
     try {
       b = load_experiment_by_name(j["base"].get<std::string>());
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(where + ".base: " + e.what());
+    } catch (const std::invalid_argument& e) {  // named here only where no file of the chain names it
+      const std::string what = e.what();
+      throw std::invalid_argument(what.starts_with("no experiment file or built-in") ? where + ".base: " + what : what);
     }
     x.pipeline = b.pipeline;
     x.integrator = b.integrator;
@@ -67,13 +68,16 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       x.until_converged = v.get<bool>();
     } else if (k == "scene") apply_json(x.scene, v, where + ".scene", dir);
     else if (k == "sweep" || k == "base") continue;  // read by parse_sweep / above
-    else
+    else {
+      const std::string hint = "; a scene's key: put it under \"scene\" (a file that is a scene goes to --scene)";
       throw std::invalid_argument(where + "." + k +
                                   ": unknown key (expected name, description, pipeline, integrator, "
-                                  "until_converged, base, scene, sweep)" +
-                                  (is_scene_key(k) ? "; a scene's key: give a scene file with --scene" : ""));
+                                  "until_converged, base, scene, sweep)" + (is_scene_key(k) ? hint : ""));
+    }
   }
   x.raw = j;
+  // A sweep without its own integrators reads the experiment's from here: a base's, written in.
+  if (!j.contains("integrator")) x.raw["integrator"] = x.integrator;
   return x;
 }
 

@@ -112,7 +112,8 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   if (s.sizes.empty() == s.models.empty()) bad(w, "needs either sizes or models");
   if (!s.orders.empty() && s.models.empty()) bad(w + ".orders", "node orders go with models");
   if (s.pipelines.empty()) bad(w, "needs pipelines");
-  // Without its own list the sweep takes the experiment's integrator, and an error names that key.
+  // Without its own list the sweep takes the experiment's integrator (a base's is written into
+  // the experiment's JSON), and an error names that key.
   const std::string integrators_key = s.integrators.empty() ? where + ".integrator" : w + ".integrators";
   if (s.integrators.empty()) s.integrators = {x.value("integrator", std::string("semi-implicit-euler"))};
   if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};

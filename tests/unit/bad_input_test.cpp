@@ -280,8 +280,9 @@ const std::vector<BadInput>& cases() {
       scene("runaway_zero", "{\"runaway_factor\": 0}", "s.json.runaway_factor: expected a number > 0"),
       // experiment and calibration files
       {"experiment_key", "run --experiment {dir}/x.json", "x.json.pipline: unknown key", {{"x.json", "{\"pipline\": \"cpu\"}"}}},
-      {"experiment_given_a_scene", "run --experiment {dir}/x.json", "x.json.dt: unknown key (expected name, "
-       "description, pipeline, integrator, until_converged, base, scene, sweep); a scene's key: give a scene file with --scene",
+      {"experiment_given_a_scene", "run --experiment {dir}/x.json",
+       "x.json.dt: unknown key (expected name, description, pipeline, integrator, until_converged, base, scene, sweep); "
+       "a scene's key: put it under \"scene\" (a file that is a scene goes to --scene)",
        {{"x.json", "{\"dt\": 0.001}"}}},
       {"experiment_scene_value", "run --experiment {dir}/x.json", "x.json.scene.dt: expected a number > 0",
        {{"x.json", "{\"scene\": {\"dt\": -1}}"}}},

@@ -175,6 +175,12 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
   for (const std::string& n : files) EXPECT_EQ(load_experiment_by_name(n).name, n);
 }
 
+TEST(Sweep, TakesTheIntegratorOfItsExperimentsBase) {
+  const Experiment x = parse_experiment(R"({"base": "table2", "sweep": {"sizes": [4], "pipelines": ["cpu"]}})", "b.json");
+  EXPECT_EQ(x.integrator, "explicit-euler");
+  EXPECT_EQ(parse_sweep(x.raw, "b.json")->integrators, std::vector<std::string>{"explicit-euler"});
+}
+
 TEST_F(SweepTest, MeshesExperimentCells) {
   const Experiment x = load_experiment_by_name("meshes");
   const auto all = cells(*parse_sweep(x.raw, "meshes"));
