@@ -15,7 +15,7 @@ int report_errors(const std::function<int()>& body) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
   } catch (const std::bad_alloc&) {  // a size the checks before allocating did not refuse
-    std::cerr << "deformlab: error: out of host memory: the model or its outputs do not fit this machine\n";
+    std::cerr << "deformlab: error: out of memory (host or device): the model or its outputs do not fit this machine\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";

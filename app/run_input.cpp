@@ -244,13 +244,13 @@ RunInput read_run_input(const RunArgs& a, Output output) {
                    "': the only pipeline to compare with is 'reference' (double precision)");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
+  if (!mesh && in.options.count("link_view"))
+    throw BadInput("--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and this "
+                   "model is a grid");
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
   const auto t0 = std::chrono::steady_clock::now();
   in.model = build_model(in.x.scene);
   if (mesh) check_fits(in, bool(a.compare), in.model.size());
-  if (in.model.grid() && in.options.count("link_view"))
-    throw BadInput("--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and this "
-                   "model is a grid");
   in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);
   if (output == Output::folder) check_disk_fits(a, in);

@@ -234,7 +234,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     cg.setMaxIterations(std::max(100, 3 * n));
     // Eigen's sparse products take its own thread count (all of OpenMP's unless set): this
     // pipeline's, so that cpu solves on one thread. Each row is one thread's, so any count gives
-    // the same bits.
+    // the same bits. The count is process-wide: pipelines step one at a time.
     Eigen::setNbThreads(threads_);
     cg.compute(A);
     const Vec dv = cg.solve(rhs);

@@ -4,7 +4,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -57,7 +56,7 @@ float num(const json& j, const std::string& where, Range r = Range::any) {
   if (!j.is_number()) bad(where, "expected a number");
   const double d = j.get<double>();
   if (!std::isfinite(d)) bad(where, "expected a finite number");
-  if (std::abs(d) > 3.0e38) bad(where, "out of the float range (at most 3e38 in magnitude)");
+  if (std::abs(d) > 3.0e38) bad(where, "expected a number of magnitude at most 3e38 (it is read as a float)");
   if (r == Range::positive && !(d > 0)) bad(where, "expected a number > 0");
   if (r == Range::non_negative && !(d >= 0)) bad(where, "expected a number >= 0");
   // Read as float: a size, mass or constant under float's normal range would be 0 or a

@@ -108,7 +108,7 @@ const std::vector<BadInput>& cases() {
       scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
       scene("dt_negative_in_file", "{\"dt\": -0.001}", "s.json.dt: expected a number > 0"),
       scene("dt_string", "{\"dt\": \"fast\"}", "s.json.dt: expected a number"),
-      scene("dt_float_range", "{\"dt\": 1e308}", "s.json.dt: out of the float range (at most 3e38 in magnitude)"),
+      scene("dt_float_range", "{\"dt\": 1e308}", "s.json.dt: expected a number of magnitude at most 3e38 (it is read as a float)"),
       scene("gravity_two", "{\"gravity\": [0, 1]}", "s.json.gravity: expected [x, y, z]"),
       scene("wind_string", "{\"wind\": [0, \"a\", 0]}", "s.json.wind[1]: expected a number"),
       scene("damping_negative", "{\"damping\": -1}", "s.json.damping: expected a number >= 0"),
