@@ -93,6 +93,8 @@ std::int64_t drop_duplicates(std::vector<std::array<std::int32_t, N>>& elements)
 
 }  // namespace
 
+bool finite_vertex(const Vec3f& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
 std::string non_finite_vertex(const Vec3f& p) {
   std::ostringstream os;
   os << "a vertex has a NaN or infinite coordinate (" << p.x << ", " << p.y << ", " << p.z << ")";
@@ -105,7 +107,7 @@ std::vector<std::string> repair(Mesh& m) {
   if (!m.triangle.empty() && !m.tetrahedron.empty()) bad("the mesh mixes triangles and tetrahedra");
   if (n > (std::int64_t(1) << 30)) bad("mesh of " + std::to_string(n) + " vertices exceeds the limit of 2^30 nodes");
   for (const Vec3f& p : m.position)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) bad(non_finite_vertex(p));
+    if (!finite_vertex(p)) bad(non_finite_vertex(p));
   std::int64_t element = 0;
   for_each_index(m, [&](std::int32_t v) {
     if (v < 0 || v >= n)

@@ -36,9 +36,10 @@ struct Mesh {
 // face shared by more than two tetrahedra.
 std::vector<std::string> repair(Mesh& m);
 
-// "a vertex has a NaN or infinite coordinate (nan, 0, 0)": that error's words wherever a mesh's
-// vertices are checked. The coordinates name the vertex: a library's vertex order need not be
-// the file's.
+// Whether a vertex's coordinates are all finite, and "a vertex has a NaN or infinite coordinate
+// (nan, 0, 0)": that error's words wherever a mesh's vertices are checked. The coordinates name
+// the vertex: a library's vertex order need not be the file's.
+bool finite_vertex(const Vec3f& p);
 std::string non_finite_vertex(const Vec3f& p);
 
 // The model of a repaired mesh. density > 0: lumped masses (kg/m^2 for surfaces, kg/m^3 for

@@ -7,7 +7,6 @@
 #include <gmsh.h>
 
 #include <cctype>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -54,9 +53,8 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   if (!scene) bad(path, std::string("assimp: ") + importer.GetErrorString());
   for (unsigned k = 0; k < scene->mNumMeshes; ++k)
     for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
-      if (const aiVector3D& p = scene->mMeshes[k]->mVertices[v];
-          !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        bad(path, non_finite_vertex({p.x, p.y, p.z}));
+      if (const aiVector3D& a = scene->mMeshes[k]->mVertices[v]; !finite_vertex({a.x, a.y, a.z}))
+        bad(path, non_finite_vertex({a.x, a.y, a.z}));
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
                                        aiProcess_SortByPType | aiProcess_ValidateDataStructure);

@@ -13,17 +13,15 @@ namespace deformlab {
 
 namespace {
 
-bool finite(const Vec3f& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
-
 // Scales and transforms a mesh's vertices, refusing one that is not finite as read (before the
 // transform spreads a NaN to its other coordinates) or that they take out of the float range.
 void place(Mesh& m, const MeshSpec& s) {
   const auto& t = s.transform;
   for (auto& p : m.position) {
-    if (!finite(p)) throw std::invalid_argument(non_finite_vertex(p));
+    if (!finite_vertex(p)) throw std::invalid_argument(non_finite_vertex(p));
     const Vec3f from = p, q{p.x * s.scale.x, p.y * s.scale.y, p.z * s.scale.z};
     for (int r = 0; r < 3; ++r) p[r] = t[r * 4] * q.x + t[r * 4 + 1] * q.y + t[r * 4 + 2] * q.z + t[r * 4 + 3];
-    if (!finite(p)) {
+    if (!finite_vertex(p)) {
       std::ostringstream os;
       os << "its scale and transform take the vertex (" << from.x << ", " << from.y << ", " << from.z
          << ") out of the float range";
