@@ -1,9 +1,9 @@
 #include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
+#include "core/number_text.hpp"
 #include "core/one_line.hpp"
 #include "experiments/ceilings.hpp"
 #include "experiments/experiment.hpp"
@@ -72,11 +72,11 @@ int experiment_command(const ExperimentArgs& a) {
         std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
-          std::cout << ": " << std::setprecision(4) << r["median_ms"].get<double>() << " ms/step"
+          std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step"
                     << (p.kept ? " (kept)" : "");
         else
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
-        std::cout << std::setprecision(3) << "  [" << p.elapsed_s << " s, about " << std::ceil(left) << " s left]"
+        std::cout << "  [" << duration_text(p.elapsed_s) << ", about " << duration_text(std::ceil(left)) << " left]"
                   << std::endl;
       };
       nlohmann::json command = a.argv;

@@ -2,11 +2,11 @@
 // scene can name as its model's "file", so that runs share one mesh.
 #include <chrono>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
 #include <stdexcept>
 
 #include "commands.hpp"
+#include "core/number_text.hpp"
 #include "experiments/sweep_models.hpp"
 #include "mesh/scene_model.hpp"
 
@@ -60,10 +60,11 @@ int mesh_command(const MeshArgs& a) {
                                      : "after the model's scale and transform): name it as the model's \"file\" with "
                                        "no fill, scale or transform (\"fill\": \"none\", \"scale\": 1, "
                                        "\"transform\": {} where the scene sets them)";
-    std::cout << std::setprecision(3) << "deformlab mesh: "
-              << (ms.generate ? describe(*ms.generate) : describe(scene.model)) << "\n  " << m.position.size()
-              << " nodes, " << (m.volume() ? m.tetrahedron.size() : m.triangle.size())
-              << (m.volume() ? " tetrahedra" : " triangles") << ", made and written in " << s << " s (host clock)\n"
+    std::cout << "deformlab mesh: " << (ms.generate ? describe(*ms.generate) : describe(scene.model)) << "\n  "
+              << counted(std::int64_t(m.position.size()), "node") << ", "
+              << (m.volume() ? counted(std::int64_t(m.tetrahedron.size()), "tetrahedron", "tetrahedra")
+                             : counted(std::int64_t(m.triangle.size()), "triangle"))
+              << ", made and written in " << duration_text(s) << " (host clock)\n"
               << "  wrote " << a.out << " (binary MSH 4.1, " << naming << " and every run reads this mesh\n";
     return 0;
   });

@@ -6,20 +6,14 @@
 #include <cstdio>
 #include <iostream>
 
+#include "core/number_text.hpp"
+
 namespace deformlab::app {
 
 namespace {
 
 constexpr auto kInterval = std::chrono::milliseconds(500);
 constexpr const char* kClearLine = "\r\x1b[K";
-
-std::string seconds(double s) {
-  char out[32];
-  if (s < 60) std::snprintf(out, sizeof out, "%.1f s", s);
-  else if (s < 3600) std::snprintf(out, sizeof out, "%d min %02d s", int(s) / 60, int(s) % 60);
-  else std::snprintf(out, sizeof out, "%d h %02d min", int(s) / 3600, int(s) % 3600 / 60);
-  return out;
-}
 
 }  // namespace
 
@@ -48,10 +42,10 @@ std::string ProgressLine::text(int step, double displacement, double elapsed_s) 
   char head[160];
   std::snprintf(head, sizeof head, "  step %d of %s%d (%.0f%%), %.4g s simulated, %s on the host clock", step,
                 threshold_ > 0 ? "at most " : "", max_steps_, 100.0 * step / max_steps_, step * dt_,
-                seconds(elapsed_s).c_str());
+                duration_text(elapsed_s).c_str());
   std::string line = head;
   const double left = elapsed_s / step * (max_steps_ - step);
-  line += (threshold_ > 0 ? ", at most " : ", about ") + seconds(left) + " left";
+  line += (threshold_ > 0 ? ", at most " : ", about ") + duration_text(left) + " left";
   if (threshold_ > 0 && displacement > 0) {
     char tail[96];
     std::snprintf(tail, sizeof tail, "; moved %.3g m (stops under %.3g)", displacement, threshold_);

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "core/clock_watch.hpp"
 #include "core/cpu_backend.hpp"
+#include "core/number_text.hpp"
 #include "core/run.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
@@ -184,8 +185,8 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   std::cout << "deformlab run: "
             << (a.scene ? "scene " + *a.scene + " (in place of " + experiment + ")" : in.x.name.empty() ? "scene" : in.x.name)
             << " on " << in.entry->name << " ("
-            << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << m.node_count() << " nodes, "
-            << m.spring_count() << " springs\n";
+            << info(in.integ).name << "), " << describe(in.x.scene.model) << ": " << counted(m.node_count(), "node")
+            << ", " << counted(m.spring_count(), "spring") << "\n";
   for (const auto& [name, value] : pipe.chosen_options())
     std::cout << "  option " << name << "=" << value << ": chosen for this machine (none given)\n";
   for (const auto& line : m.repairs) std::cout << "  mesh: " << line << "\n";
@@ -195,11 +196,11 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
               << in.params.threshold << " m in the last step\n";
   else
     std::cout << "fixed step count\n";
-  std::cout << std::setprecision(4) << "  time: median " << med.step_ms << " ms/step (" << r.clock << "), "
-            << r.total_ms / 1000.0 << " s in steps";
+  std::cout << "  time: median " << significant(med.step_ms, 4) << " ms/step (" << r.clock << "), "
+            << duration_text(r.total_ms / 1000.0) << " in steps";
   if (r.clock != HostStepTimer().clock())
-    std::cout << "; queueing a step took " << med.queue_ms << " ms on the host clock";
-  std::cout << "; the run took " << r.wall_ms / 1000.0 << " s on the host clock (checks"
+    std::cout << "; queueing a step took " << significant(med.queue_ms, 4) << " ms on the host clock";
+  std::cout << "; the run took " << duration_text(r.wall_ms / 1000.0) << " on the host clock (checks"
             << (a.frames ? ", frames" : "") << " included)\n";
   if (on_gpu(*in.entry)) std::cout << "  clock: " << describe(ran.clock) << "\n";
   if (a.compare)
@@ -212,24 +213,24 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   for (const auto& g : profiler.summary()) {
     // A GPU pipeline's check is the host waiting for the device's work, then reading its result.
     const bool waits = on_gpu(*in.entry) && g.name == span::reductions;
-    std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(10) << g.median_ms
-              << " ms  (" << g.clock << (waits ? ", waiting for the device" : "");
+    std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(11)
+              << significant(g.median_ms, 4) << " ms  (" << g.clock << (waits ? ", waiting for the device" : "");
     if (g.steps < sampled) std::cout << "; in " << g.steps << (g.steps == 1 ? " step" : " steps");
     std::cout << ")\n";
   }
   const json mem = memory_of(in);
   const double nodes = double(m.node_count());
-  std::cout << "  setup: model built in " << in.build_s << " s, pipeline in " << setup_s << " s";
+  std::cout << "  setup: model built in " << duration_text(in.build_s) << ", pipeline in " << duration_text(setup_s);
   if (warm.steps > 0)
-    std::cout << "; warm-up: " << warm.steps << " untimed steps from rest in " << warm.ms / 1000.0
-              << " s, then back to rest";
+    std::cout << "; warm-up: " << counted(warm.steps, "untimed step") << " from rest in "
+              << duration_text(warm.ms / 1000.0) << ", then back to rest";
   std::cout << " (host clock)\n";
+  const auto per_node = [&](const char* key) { return significant(mem[key].get<double>() / nodes, 3) + " B"; };
   std::cout << "  memory: host " << gib(mem["peak_resident_bytes"]) << " resident at peak; counted per node: model "
-            << mem["model_host_bytes"].get<double>() / nodes << " B, pipeline "
-            << mem["pipeline_host_bytes"].get<double>() / nodes << " B, state "
-            << mem["state_host_bytes"].get<double>() / nodes << " B";
+            << per_node("model_host_bytes") << ", pipeline " << per_node("pipeline_host_bytes") << ", state "
+            << per_node("state_host_bytes");
   if (mem["pipeline_device_bytes"].get<std::int64_t>() > 0)
-    std::cout << "; device " << mem["pipeline_device_bytes"].get<double>() / nodes << " B ("
+    std::cout << "; device " << per_node("pipeline_device_bytes") << " ("
               << gib(mem["pipeline_device_bytes"]) << ")";
   std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
             << "manifest.json" << (a.trace ? ", trace.json" : "") << (a.frames ? ", frames/" : "") << "}\n";

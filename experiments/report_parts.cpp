@@ -4,6 +4,8 @@
 
 #include "report_parts.hpp"
 
+#include "core/number_text.hpp"
+
 namespace deformlab::report {
 
 using nlohmann::json;
@@ -12,7 +14,7 @@ std::string fmt(double v) {
   std::ostringstream os;
   if (v >= 100) os << std::fixed << std::setprecision(1) << v;
   else if (v >= 1) os << std::fixed << std::setprecision(3) << v;
-  else os << std::setprecision(3) << v;
+  else os << significant_trimmed(v, 3);
   return os.str();
 }
 
@@ -20,7 +22,7 @@ std::string percent(double v) {
   std::ostringstream os;
   if (v >= 10) os << std::lround(v);
   else if (v >= 1) os << std::fixed << std::setprecision(1) << v;
-  else os << std::setprecision(2) << v;
+  else os << significant_trimmed(v, 2);
   return os.str() + "%";
 }
 

@@ -1,0 +1,49 @@
+#include "number_text.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace deformlab {
+
+std::string significant(double v, int digits) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+  char out[64];
+  if (v == 0) return "0";
+  // Round first, so that 9.9996 to 4 digits counts its decimals from 10.00, not 9.9996.
+  const int exponent = int(std::floor(std::log10(std::fabs(v))));
+  int decimals = digits - 1 - exponent;
+  const double rounded = decimals >= 0 ? std::round(v * std::pow(10.0, decimals)) / std::pow(10.0, decimals) : v;
+  if (rounded != 0 && int(std::floor(std::log10(std::fabs(rounded)))) > exponent) --decimals;
+  std::snprintf(out, sizeof out, "%.*f", decimals > 0 ? decimals : 0, v);
+  return out;
+}
+
+std::string significant_trimmed(double v, int digits) {
+  std::string s = significant(v, digits);
+  if (s.find('.') == std::string::npos) return s;
+  while (s.back() == '0') s.pop_back();
+  if (s.back() == '.') s.pop_back();
+  return s;
+}
+
+std::string duration_text(double s) {
+  char out[48];
+  // Each unit up to where its three digits would round to 1000 (or to a minute).
+  if (s < 59.95) {
+    const auto [scale, unit] =
+        s < 999.5e-6 ? std::pair{1e6, " µs"} : s < 0.9995 ? std::pair{1e3, " ms"} : std::pair{1.0, " s"};
+    return significant(s * scale, 3) + unit;
+  }
+  const long r = std::lround(s);
+  if (r < 3600) std::snprintf(out, sizeof out, "%ld min %02ld s", r / 60, r % 60);
+  else std::snprintf(out, sizeof out, "%ld h %02ld min", r / 3600, r % 3600 / 60);
+  return out;
+}
+
+std::string counted(std::int64_t n, std::string_view noun, std::string_view plural) {
+  std::string out = std::to_string(n) + " ";
+  if (n == 1) return out.append(noun);
+  return plural.empty() ? out.append(noun).append("s") : out.append(plural);
+}
+
+}  // namespace deformlab
