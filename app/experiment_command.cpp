@@ -66,6 +66,7 @@ int experiment_command(const ExperimentArgs& a) {
                 << dir.string() << " (cells already there are kept)\n";
       SweepOptions o;
       o.calibration = calibration;
+      o.max_size = a.max_size;
       o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
         const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0;

@@ -28,6 +28,7 @@ std::string significant_trimmed(double v, int digits) {
 
 std::string duration_text(double s) {
   char out[48];
+  if (s == 0) return "0 s";
   // Each unit up to where its three digits would round to 1000 (or to a minute).
   if (s < 59.95) {
     const auto [scale, unit] =

@@ -302,7 +302,13 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   }
   cache = {};
   if (s.frames > 0 && !fs::exists(dir / "frames")) {
-    manifest["frames"] = render_frames(x, s, dir);
+    const ModelSpec& m = x.scene.model;
+    const bool sized = m.topology != Topology::general;
+    if (o.max_size && sized && std::max({m.nx, m.ny, m.nz}) > *o.max_size)
+      manifest["frames"] = {{"unavailable", "the experiment's " + describe(m) + " is over --max-size " +
+                                                std::to_string(*o.max_size) + "; a run without it renders them"}};
+    else
+      manifest["frames"] = render_frames(x, s, dir);
     write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
   }
   return ran;

@@ -63,12 +63,15 @@ struct SweepOptions {
   // This device's ceilings (`deformlab calibrate`'s JSON) for the manifest and the report;
   // null keeps the calibration the folder's manifest already has.
   nlohmann::json calibration;
+  // --max-size: the experiment's own grid or lattice larger than this along an axis leaves
+  // its frames to a later run, as the sweep's larger sizes are.
+  std::optional<int> max_size;
 };
 
 // Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again) and returns
 // the number it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first;
 // then, unless `dir`/frames/ exists, renders the sweep's frames there (render_frames) and
-// records them, or why there are none, as the manifest's "frames".
+// records them, or why there are none (for now, under `o.max_size`), as the manifest's "frames".
 int run_sweep(const Experiment& x, const Sweep& s, const std::filesystem::path& dir, const SweepOptions& o,
               const nlohmann::json& command);
 

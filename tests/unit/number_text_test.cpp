@@ -29,6 +29,7 @@ TEST(NumberText, SignificantDigitsNeverUseAnExponent) {
 }
 
 TEST(NumberText, DurationsTakeTheUnitThatSuitsThem) {
+  EXPECT_EQ(duration_text(0), "0 s");
   EXPECT_EQ(duration_text(4.532e-05), "45.3 µs");
   EXPECT_EQ(duration_text(0.009062), "9.06 ms");
   EXPECT_EQ(duration_text(0.9996), "1.00 s");

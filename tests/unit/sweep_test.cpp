@@ -106,6 +106,27 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   }
 }
 
+// Under --max-size the experiment's own grid, if larger, leaves its frames for a later run, as
+// it leaves the sweep's larger sizes; the run without it renders them (or says why it cannot).
+TEST_F(SweepTest, FramesOfAGridOverMaxSizeWaitForALaterRun) {
+  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 1, "repetitions": 1})");
+  const Sweep s = *parse_sweep(x.raw, "tiny");
+  SweepOptions o;
+  o.max_size = 3;
+  run_sweep(x, s, dir_, o, json::array());
+  json frames = json::parse(slurp(dir_ / "manifest.json"))["frames"];
+  EXPECT_EQ(frames["unavailable"], "the experiment's cloth 4x4 is over --max-size 3; a run without it renders them");
+  EXPECT_FALSE(fs::exists(dir_ / "frames"));
+  EXPECT_NE(slurp(write_report(dir_)).find("None: the experiment's cloth 4x4 is over --max-size 3"), std::string::npos);
+  o.max_size = 4;  // not over it
+  run_sweep(x, s, dir_, o, json::array());
+  frames = json::parse(slurp(dir_ / "manifest.json"))["frames"];
+  EXPECT_EQ(frames.contains("files"), fs::exists(dir_ / "frames")) << frames.dump();
+  if (!frames.contains("files")) {
+    EXPECT_NE(frames["unavailable"].get<std::string>().find("OpenGL"), std::string::npos);
+  }
+}
+
 // Mesh models x node orders: every cell measured, ids distinct, each mesh generated or read
 // once and each (model, order) built once, the report's tables per model, a resumed folder
 // skipping what is done.
