@@ -1,5 +1,6 @@
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 #include "commands.hpp"
 #include "core/integrator.hpp"
@@ -7,6 +8,21 @@
 #include "experiments/pipelines.hpp"
 
 namespace deformlab::app {
+
+namespace {
+
+// What each option takes, as `run --option NAME=VALUE` reads it (README: Using it).
+std::string option_values(const std::string& name) {
+  static const std::map<std::string, std::string> values = {
+      {"tile", "WxH"},     {"tma", "on|off"},    {"math", "exact|fast"},
+      {"window", "N"},     {"link_view", "N"},   {"steps_per_launch", "1-8"},
+      {"memory", "gl|cuda"}, {"force", "naive|tiled|scatter"},
+      {"interop", "map|external|external-gpusync|staged"}};
+  const auto v = values.find(name);
+  return v == values.end() ? "VALUE" : v->second;
+}
+
+}  // namespace
 
 int list_command() {
   std::cout << "Pipelines (in order of expected speed; 'best' picks the first available, passing over GL on a "
@@ -16,7 +32,11 @@ int list_command() {
     std::cout << "  " << std::left << std::setw(15) << e.name << (why.empty() ? "available    " : "unavailable  ")
               << e.summary << (e.traits.deterministic ? "" : " [not bitwise deterministic]")
               << (on_software_gl(e) ? " [software GL: slower than the CPU pipelines here]" : "") << "\n";
-    for (const auto& o : e.options) std::cout << "  " << std::setw(15) << "" << "  option: " << o << "\n";
+    if (!e.options.empty()) {
+      std::cout << "  " << std::setw(15) << "" << "  options:";
+      for (const auto& o : e.options) std::cout << " " << o << "=" << option_values(o);
+      std::cout << "\n";
+    }
     if (!why.empty()) {
       std::cout << "  " << std::setw(15) << "" << "  why: " << why << "\n";
       continue;
@@ -28,7 +48,7 @@ int list_command() {
   const Integrator usual = *parse_integrator(default_experiment().integrator);
   std::cout << "\n'best' here: " << best_pipeline(usual).name << " (for " << info(usual).name
             << ", the main job's integrator)\n";
-  std::cout << "\nIntegrators (name, paper's name, force passes per step, order):\n";
+  std::cout << "\nIntegrators (name, the paper's name also accepted, force passes per step, order):\n";
   for (const auto& i : integrators())
     std::cout << "  " << std::left << std::setw(21) << i.name << std::setw(18)
               << (i.paper_alias.empty() ? "-" : std::string(i.paper_alias)) << i.force_passes << "  " << i.order

@@ -17,7 +17,6 @@ namespace deformlab::bench {
 // experiment's scene (spring damping, ground, sphere, the centre node dragged, dt 50 us).
 // `idealised`: 1 m, top corners pinned, undamped springs, no contact, no drag, dt 1 ms.
 enum class SceneKind { paper, idealised };
-SceneKind parse_scene_kind(const std::string& s);  // throws std::invalid_argument
 const char* to_string(SceneKind k);
 std::string describe(SceneKind k);
 
@@ -57,14 +56,14 @@ std::string fixed(double v, int prec);
 // benches' untimed work before each case (add_warmup_ms).
 struct BenchOptions {
   std::vector<int> sizes;
-  std::string scene = "paper";
+  bool idealised = false;  // --idealised: that scene in place of the paper's
   int warmup = 5;
   double warmup_ms = kGpuWarmUpMs;
   std::string integrator = "semi-implicit-euler";
   std::string csv;  // also write the rows here when set
   // `integrator` parsed; throws std::invalid_argument naming it when unknown.
   Integrator integ() const;
-  SceneKind scene_kind() const { return parse_scene_kind(scene); }
+  SceneKind scene_kind() const { return idealised ? SceneKind::idealised : SceneKind::paper; }
 };
 void add_bench_options(CLI::App& c, BenchOptions& o);
 void add_warmup_ms(CLI::App& c, BenchOptions& o);

@@ -13,12 +13,6 @@
 
 namespace deformlab::bench {
 
-SceneKind parse_scene_kind(const std::string& s) {
-  for (SceneKind k : {SceneKind::paper, SceneKind::idealised})
-    if (s == to_string(k)) return k;
-  throw std::invalid_argument("unknown bench scene '" + s + "' (paper, idealised)");
-}
-
 const char* to_string(SceneKind k) { return k == SceneKind::paper ? "paper" : "idealised"; }
 
 std::string describe(SceneKind k) {
@@ -90,8 +84,8 @@ Integrator BenchOptions::integ() const {
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
-  c.add_option("--scene", o.scene, "Scene: paper (table2's) or idealised")
-      ->check(CLI::IsMember({to_string(SceneKind::paper), to_string(SceneKind::idealised)}));
+  c.add_flag("--idealised", o.idealised,
+             "Time the idealised scene (undamped, no contact, no drag) in place of the paper's (table2's)");
   c.add_option("--warmup", o.warmup, "Warm-up steps")->check(CLI::PositiveNumber);
   c.add_option("--integrator", o.integrator, "Integrator");
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");

@@ -28,13 +28,13 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   auto read_options = [](Update u) {
     return [u](const PipelineOptions& o) { interop::hybrid_options(o, u); };
   };
-  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update (options: interop, force, tile, math)",
+  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update",
          updating_on(Engine::gl_transform_feedback), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
          },
          options, footprint(Update::transform_feedback), read_options(Update::transform_feedback)});
-  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update (options: interop, force, tile, math)",
+  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update",
          updating_on(Engine::gl_compute), unavailable, unsupported,
          [](const PipelineSetup& s) {
            return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
