@@ -23,6 +23,15 @@ namespace {
   throw std::invalid_argument("mesh file '" + file + "': " + what);
 }
 
+// What assimp refused, after "assimp:", its runs of spaces made one (it names a mesh without
+// a name as "Mesh  contains no faces").
+[[noreturn]] void refused_by_assimp(const std::string& file, const Assimp::Importer& importer) {
+  std::string why;
+  for (const char* c = importer.GetErrorString(); *c; ++c)
+    if (!(*c == ' ' && !why.empty() && why.back() == ' ')) why += *c;
+  bad(file, "assimp: " + why);
+}
+
 // assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
 // file is refused first (the header is text, within its first 64 KiB in any file we know).
 void require_ply_header_end(const std::string& path) {
@@ -50,7 +59,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   // Read first, checked for coordinates that are not finite, then processed: joining identical
   // vertices would otherwise merge a NaN vertex into another and hide it.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
-  if (!scene) bad(path, std::string("assimp: ") + importer.GetErrorString());
+  if (!scene) refused_by_assimp(path, importer);
   for (unsigned k = 0; k < scene->mNumMeshes; ++k)
     for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
       if (const aiVector3D& a = scene->mMeshes[k]->mVertices[v]; !finite_vertex({a.x, a.y, a.z}))
@@ -58,7 +67,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
                                        aiProcess_SortByPType | aiProcess_ValidateDataStructure);
-  if (!scene) bad(path, std::string("assimp: ") + importer.GetErrorString());
+  if (!scene) refused_by_assimp(path, importer);
   Mesh m;
   std::int64_t points = 0, lines = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
