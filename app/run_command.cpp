@@ -243,7 +243,11 @@ int run_command(const RunArgs& a) {
     // 1. Everything is read and checked before anything is written (bad input: exit 2).
     const RunInput in = read_run_input(a);
     // 2. Run, writing into a staging folder that is committed only on success.
-    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames/"});
+    std::vector<std::string> writes = {"timings.csv", "spans.csv"};
+    if (!a.no_state) writes.push_back("state.ply");
+    if (a.trace) writes.push_back("trace.json");
+    if (a.frames) writes.push_back("frames/");
+    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames/"}, writes);
     const auto t0 = std::chrono::steady_clock::now();
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -51,19 +51,37 @@ void require_holds_nothing_but(const fs::path& dir, Holds want) {
 
 fs::path temporary(const fs::path& name) { return name.string() + ".tmp-" + std::to_string(::getpid()); }
 
+namespace {
+
+// Whether `name` is a temporary ("*.tmp-<pid>", ".staging-<pid>") of this process or of one
+// that is gone.
+bool reclaimable(const std::string& name) {
+  std::size_t at = name.rfind(".tmp-");
+  std::size_t len = 5;
+  if (name.rfind(".staging-", 0) == 0) at = 0, len = 9;
+  if (at == std::string::npos) return false;
+  const std::string digits = name.substr(at + len);
+  if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return false;
+  const pid_t pid = pid_t(std::stol(digits));
+  return pid == ::getpid() || (::kill(pid, 0) == -1 && errno == ESRCH);
+}
+
+// Whether `dir` holds the staging folder of a process that is gone: one stopped in its commit
+// (or before it), whose outputs may have been moved in without their manifest.
+bool holds_stopped_staging(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (const std::string name = e.path().filename().string(); name.starts_with(".staging-") && reclaimable(name))
+      return true;
+  return false;
+}
+
+}  // namespace
+
 void reclaim_temporaries(const fs::path& dir) {
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    std::size_t at = name.rfind(".tmp-");
-    std::size_t len = 5;
-    if (name.rfind(".staging-", 0) == 0) at = 0, len = 9;
-    if (at == std::string::npos) continue;
-    const std::string digits = name.substr(at + len);
-    if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
-    const pid_t pid = pid_t(std::stol(digits));
-    if (pid == ::getpid() || (::kill(pid, 0) == -1 && errno == ESRCH)) fs::remove_all(e.path(), ec);
-  }
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (reclaimable(e.path().filename().string())) fs::remove_all(e.path(), ec);
 }
 
 namespace {
@@ -88,13 +106,28 @@ void OutputDir::require_replaceable(const std::vector<std::string>& names) const
   }
 }
 
-OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs) : dir_(dir), outputs_(std::move(outputs)) {
+void OutputDir::require_ours(const std::vector<std::string>& writes, bool commit_stopped) const {
+  std::error_code ec;
+  const json old = held_output_ ? read_manifest(dir_) : json();
+  for (const auto& name : writes) {
+    if (commit_stopped || !fs::exists(fs::symlink_status(dir_ / entry_name(name), ec))) continue;
+    // A manifest without "files" predates the list: its folder's outputs are taken as its own.
+    if (held_output_ && (!old.contains("files") || old["files"].contains(name))) continue;
+    throw std::invalid_argument("output folder '" + dir_.string() + "' holds '" + name +
+                                "', which no earlier run's manifest there names (not a deformlab output): move it "
+                                "or give another --out");
+  }
+}
+
+OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes)
+    : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
   require_replaceable(outputs_);
   require_replaceable({"manifest.json"});
   created_ = !fs::exists(dir_, ec);
   held_output_ = folder_holds(dir_) == Holds::run;
+  require_ours(writes, holds_stopped_staging(dir_));
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
   reclaim_temporaries(dir_);

@@ -42,8 +42,11 @@ class OutputDir {
   // `outputs`: every name such an output may hold besides manifest.json, a folder's ending in
   // '/'; where the folder held one (its manifest says so), commit() removes those the new one
   // does not write, so that the folder holds one output's files. Files in a folder that held
-  // none are left alone.
-  OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs);
+  // none are left alone. `writes`: those of `outputs` this output will write; each that is in
+  // the folder already must be the earlier output's (its manifest's "files" names it) or left
+  // by a commit that was stopped (a stopped process's staging folder is there), else it is
+  // someone else's and std::invalid_argument is thrown rather than replace it.
+  OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes);
   // Removes the staging folder, and the output folder too if this object created it and
   // nothing was committed.
   ~OutputDir();
@@ -65,6 +68,7 @@ class OutputDir {
   // Throws std::invalid_argument where one of `names` (a folder's ending in '/') is in the
   // output folder as the other kind of entry.
   void require_replaceable(const std::vector<std::string>& names) const;
+  void require_ours(const std::vector<std::string>& writes, bool commit_stopped) const;
   std::filesystem::path dir_, staging_;
   std::vector<std::string> outputs_;
   bool held_output_ = false;  // the folder held such an output when this object was made

@@ -2,7 +2,8 @@
 // refused before anything changes (after the run, with its outputs kept); a commit stopped
 // between its renames leaves a folder without a manifest, the mark of an incomplete run, and
 // the next run's commit completes it; a commit leaves none of the old output's files that the
-// new one lacks; a folder holds one run or one experiment; a failed write says why.
+// new one lacks, and replaces nothing no run wrote; a folder holds one run or one experiment; a
+// failed write says why.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -32,6 +33,7 @@ std::string read(const fs::path& f) {
 }
 
 const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames/"};
+const std::vector<std::string> kWrites = {"summary.txt", "state.ply"};  // what the tests' outputs write
 
 TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
   const fs::path dir = fresh("deformlab-commit-in-the-way");
@@ -41,17 +43,17 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
   const std::string error = "output folder '" + dir.string() +
                             "' holds a folder named 'state.ply' where this output writes a file: move it or give another --out";
   try {
-    OutputDir out(dir, kOutputs);
+    OutputDir out(dir, kOutputs, kWrites);
     ADD_FAILURE() << "accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(e.what(), error);
   }
   fs::remove_all(dir / "state.ply");
   write(dir / "frames", "a file where the output has a folder");
-  EXPECT_THROW(OutputDir(dir, kOutputs), std::invalid_argument);
+  EXPECT_THROW(OutputDir(dir, kOutputs, kWrites), std::invalid_argument);
   fs::remove(dir / "frames");
   {
-    OutputDir out(dir, kOutputs);  // the entry appears during the run
+    OutputDir out(dir, kOutputs, kWrites);  // the entry appears during the run
     write(out.staged("summary.txt"), "new");
     write(out.staged("state.ply"), "new");
     write(out.staged("manifest.json"), "new");
@@ -72,11 +74,12 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
 
 TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesIt) {
   const fs::path dir = fresh("deformlab-commit-stopped");
-  for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(dir / f, "old");
+  for (const char* f : {"summary.txt", "state.ply"}) write(dir / f, "old");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag"})");  // a run's
   // A process that stops for good after its commit's first rename (as if killed there).
   EXPECT_EXIT(
       {
-        OutputDir out(dir, kOutputs);
+        OutputDir out(dir, kOutputs, kWrites);
         for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "new");
         out.commit([](const fs::path&) { ::_exit(3); });
       },
@@ -88,7 +91,7 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   EXPECT_EQ(moved, 1) << "one output moved in before the stop";
   EXPECT_EQ(staging, 1) << "the stopped process's staging folder";
   {
-    OutputDir out(dir, kOutputs);
+    OutputDir out(dir, kOutputs, kWrites);
     for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "newer");
     out.commit();
   }
@@ -105,7 +108,7 @@ TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
   for (const char* f : {"summary.txt", "state.ply", "trace.json", "notes.txt"}) write(dir / f, "old");
   write(dir / "manifest.json", R"({"experiment": "paper-drag"})");  // a run's
   {
-    OutputDir out(dir, kOutputs);
+    OutputDir out(dir, kOutputs, kWrites);
     write(out.staged("summary.txt"), "new");
     write(out.staged("manifest.json"), "new");
     out.commit();
@@ -123,12 +126,42 @@ TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
   write(dir / "frames" / "mine.png", "mine");
   write(dir / "trace.json", "mine");
   {
-    OutputDir out(dir, kOutputs);
+    OutputDir out(dir, kOutputs, {});
     write(out.staged("manifest.json"), "new");
     out.commit();
   }
   EXPECT_EQ(read(dir / "frames" / "mine.png"), "mine");
   EXPECT_EQ(read(dir / "trace.json"), "mine");
+  fs::remove_all(dir);
+}
+
+// An output that would replace an entry no earlier run wrote is refused before the run: in a
+// folder that held no run, and in one whose run's manifest does not name it.
+TEST(OutputDir, WhatNoRunWroteIsNotReplaced) {
+  const fs::path dir = fresh("deformlab-commit-theirs");
+  fs::create_directories(dir / "frames");
+  write(dir / "frames" / "keep.txt", "mine");
+  const std::string error = "output folder '" + dir.string() +
+                            "' holds 'frames/', which no earlier run's manifest there names (not a deformlab output): "
+                            "move it or give another --out";
+  const std::vector<std::string> with_frames = {"summary.txt", "frames/"};
+  try {
+    OutputDir out(dir, kOutputs, with_frames);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(e.what(), error);
+  }
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": ""}})");
+  EXPECT_THROW(OutputDir(dir, kOutputs, with_frames), std::invalid_argument) << "a run that wrote no frames";
+  EXPECT_EQ(read(dir / "frames" / "keep.txt"), "mine");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": "", "frames/": ""}})");
+  {
+    OutputDir out(dir, kOutputs, with_frames);  // the earlier run's frames: replaced
+    fs::create_directories(out.staged("frames"));
+    write(out.staged("manifest.json"), "new");
+    out.commit();
+  }
+  EXPECT_FALSE(fs::exists(dir / "frames" / "keep.txt"));
   fs::remove_all(dir);
 }
 
