@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "run_input.hpp"
 #include "core/number_text.hpp"
 #include "core/one_line.hpp"
 #include "experiments/ceilings.hpp"
@@ -36,8 +37,9 @@ int experiment_command(const ExperimentArgs& a) {
   nlohmann::json calibration;
   try {
     require_folder_or_nothing(dir);
+    if (!a.report_only) require_writable(dir);
     require_holds_nothing_but(dir, Holds::experiment);
-    if (!a.report_only) require_same_experiment(dir, x.name);
+    require_same_experiment(dir, x.name);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
@@ -84,7 +86,8 @@ int experiment_command(const ExperimentArgs& a) {
       const int ran = run_sweep(x, *sweep, dir, o, command);
       std::cout << "ran " << ran << " cells, kept " << int(cells(*sweep).size()) - ran << "\n";
     }
-    std::cout << "report: " << write_report(dir).string() << "\n";
+    const std::filesystem::path report = write_report(dir);
+    std::cout << "report: " << report.string() << "\n";
     return 0;
   });
 }

@@ -164,9 +164,10 @@ std::filesystem::path existing_part(const std::filesystem::path& out) {
   return at;
 }
 
-// Refuses an output folder on one of the kernel's own file systems (proc, sysfs, ...), which
-// hold no files of ours, or where this process may not write.
+}  // namespace
+
 void require_writable(const std::filesystem::path& out) {
+  if (out.empty()) throw BadInput("--out '': an empty path names no folder");
   const std::filesystem::path at = existing_part(out);
   const std::string folder = "output folder '" + out.string() + "'";
   struct statfs f{};
@@ -175,8 +176,12 @@ void require_writable(const std::filesystem::path& out) {
                                          BPF_FS_MAGIC,     DEVPTS_SUPER_MAGIC};
   if (::statfs(at.c_str(), &f) == 0 && std::ranges::find(kKernelFileSystems, long(f.f_type)) != std::end(kKernelFileSystems))
     throw BadInput(folder + ": '" + at.string() + "' is on one of the kernel's file systems (such as proc or sysfs)");
+  if (std::error_code ec; !std::filesystem::is_directory(at, ec))
+    throw BadInput(folder + ": '" + at.string() + "' is not a folder");
   if (::access(at.c_str(), W_OK) != 0) throw BadInput(folder + ": '" + at.string() + "' is not writable");
 }
+
+namespace {
 
 void check_disk_fits(const RunArgs& a, const RunInput& in) {
   const std::filesystem::path at = existing_part(in.out);

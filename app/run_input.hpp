@@ -32,6 +32,10 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag);
 // The flags' own values (sizes, dt, steps, ...), checked with no experiment read and no GL
 // context made: `view` checks them before it opens its window.
 void check_run_flags(const RunArgs& a);
+// Refuses an output folder (of a run or an experiment) that is an empty path, lies on one of
+// the kernel's own file systems (proc, sysfs, ...), which hold no files of ours, or where this
+// process may not write (the nearest folder above it that exists, where it does not).
+void require_writable(const std::filesystem::path& out);
 // `run`'s output folder is checked first, before the model is built; `view` writes none.
 enum class Output { folder, none };
 RunInput read_run_input(const RunArgs& a, Output output = Output::folder);
