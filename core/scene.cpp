@@ -223,8 +223,9 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
   // One source: a file or a generated shape; naming one replaces the other (and, for a
   // shape, a fill of the file).
   if (j.contains("file") && j.contains("generate")) bad(where + ".generate", "give either \"file\" or \"generate\", not both");
+  // "fill": "none" fills nothing, so it is a generated mesh's too (it may undo a base's fill).
   for (const char* k : {"fill", "cell_size"})
-    if (j.contains("generate") && j.contains(k))
+    if (j.contains("generate") && j.contains(k) && !(k == std::string("fill") && j[k] == "none"))
       bad(where + "." + k, "fills a surface file; a generated mesh takes generate.cell_size");
   if (j.contains("file")) {
     if (!j["file"].is_string() || j["file"].get<std::string>().empty()) bad(where + ".file", "expected a file name");

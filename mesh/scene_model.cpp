@@ -152,8 +152,9 @@ Model build_model_in_file_order(const Scene& s) {
     model = mesh_model_of(m);
   } else {
     if (m.nx < 1 || m.ny < 1 || m.nz < 1) throw std::invalid_argument("model size must be positive in every dimension");
-    float h = m.spacing;
-    if (h == 0.f) h = m.nx > 1 ? m.width / float(m.nx - 1) : m.width;
+    // `width` spans the first axis with more than one node: x, unless the grid is one node wide.
+    const int across = m.nx > 1 ? m.nx : m.ny > 1 ? m.ny : m.nz;
+    const float h = m.spacing != 0.f ? m.spacing : across > 1 ? m.width / float(across - 1) : m.width;
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
   }

@@ -1,6 +1,8 @@
 // Scene and experiment files: every key read, unknown keys and bad values named.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "core/scene.hpp"
@@ -92,6 +94,31 @@ TEST(Scene, ALayersSpacingOrWidthReplacesTheOther) {
   Scene t;
   apply_json(t, to_json(s), "t");
   EXPECT_EQ(to_json(t), to_json(s));
+}
+
+// A grid one node wide spans `width` along its next axis with more than one node, as a wider
+// one does along x: a 1 x 64 cloth is 1 m long, as a 64 x 1 one is 1 m wide.
+TEST(Scene, AGridOneNodeWideSpansItsWidthAlongItsLength) {
+  for (const auto& [size, axis] : {std::pair{"[64, 1]", 0}, std::pair{"[1, 64]", 2}}) {
+    Scene s;
+    apply_json(s, json::parse(std::string(R"({"model": {"width": 1, "size": )") + size + "}}"), "a");
+    const Model m = build_model(s);
+    const auto& p = m.rest_position;
+    EXPECT_NEAR(std::fabs(p.back()[axis] - p.front()[axis]), 1.f, 1e-6f) << size;
+  }
+  Scene lattice;
+  apply_json(lattice, json::parse(R"({"model": {"type": "lattice", "width": 1, "size": [1, 5, 3]}})"), "b");
+  const Model m = build_model(lattice);
+  EXPECT_NEAR(m.rest_position.back()[1] - m.rest_position.front()[1], 1.f, 1e-6f) << "along y";
+}
+
+// "fill": "none" fills nothing: a generated mesh takes it (it may undo a base's fill).
+TEST(Scene, AGeneratedMeshTakesFillNone) {
+  Scene s;
+  apply_json(s, json::parse(R"({"model": {"type": "mesh", "pins": "none", "fill": "none",
+                                "generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.25}}})"), "a");
+  EXPECT_FALSE(s.model.mesh.fill);
+  EXPECT_TRUE(s.model.mesh.generate.has_value());
 }
 
 TEST(Scene, ErrorsNameTheKey) {
