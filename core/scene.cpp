@@ -419,6 +419,9 @@ Params resolve_params(const Scene& s, const Model& m) {
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument((s.drag.node.where.empty() ? "drag node" : s.drag.node.where) + ": " + e.what());
     }
+    if (m.pinned(node))
+      throw std::invalid_argument((s.drag.node.where.empty() ? "drag node" : s.drag.node.where) + ": node " +
+                                  std::to_string(node) + " is pinned (model.pins), so the drag would not move it");
     p.drag.node = node;
     if (s.drag.offsets)
       for (auto& k : p.drag.path) k.position = m.rest_position[node] + k.position;

@@ -255,6 +255,8 @@ const std::vector<BadInput>& cases() {
             "s.json.model.generate.cell_size: would make about"),
       scene("generate_and_file", G(R"({"shape": "sheet", "size": [1, 1], "cell_size": 0.1}, "file": "m.obj")"),
             "s.json.model.generate: give either \"file\" or \"generate\", not both"),
+      scene("drag_a_pinned_node", R"({"drag": {"node": 0, "path": [[0.01, 0, 0.5, 0]]}})",
+            "s.json.drag.node: node 0 is pinned (model.pins), so the drag would not move it"),
       scene("generate_and_fill", G(R"({"shape": "box", "size": [1, 1, 1], "cell_size": 0.1}, "fill": "tetrahedra")"),
             "s.json.model.fill: fills a surface file"),
       // `deformlab mesh`: the file it would write is checked first, then the scene or model
