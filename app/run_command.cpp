@@ -256,6 +256,11 @@ int run_command(const RunArgs& a) {
                 << "every " << in.params.check_every << " step(s) launches the steps held at each check, fewer at a "
                 << "time, and waits for them (--check-every " << k << " or a multiple of it keeps every launch whole "
                 << "and reads each check while the next launch runs)\n";
+    // 0: no step is stable undamped (explicit Euler, midpoint), which the integrator's notes say.
+    if (const double limit = stability_limit(in.model, in.params, in.integ); limit > 0 && in.params.dt > limit)
+      std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
+                << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
+                << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
     if (in.entry->name == "cuda-temporal" && in.model.volume())
       std::cerr << "deformlab: note: on lattices cuda-temporal took longer a step than cuda-fused at every "
                 << "steps_per_launch and tile measured (H100, 256^3: a node's 32 springs bind the step to arithmetic, "

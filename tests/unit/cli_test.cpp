@@ -222,6 +222,20 @@ TEST_F(Cli, GridFlagOnAMeshSceneSaysItReplacesTheMesh) {
   EXPECT_NE(r.out.find("cloth 8x8: 64 nodes"), std::string::npos) << r.out;
 }
 
+// A dt over the integrator's bound on the linearised springs is noted (the run may still be
+// stable, damped); under it, nothing is said.
+TEST_F(Cli, NotesADtOverTheStabilityBound) {
+  const Result over = run("run --pipeline cpu --lattice 8x8x8 --steps 5 --out " + (dir_ / "over").string());
+  ASSERT_EQ(over.code, 0) << over.err;
+  EXPECT_NE(over.err.find("note: dt = 0.002 s is above semi-implicit-euler's stability bound on this model's "
+                          "linearised springs (0.00191 s)"),
+            std::string::npos)
+      << over.err;
+  const Result under = run("run --pipeline cpu --lattice 8x8x8 --dt 0.0019 --steps 5 --out " + (dir_ / "under").string());
+  ASSERT_EQ(under.code, 0) << under.err;
+  EXPECT_EQ(under.err.find("stability bound"), std::string::npos) << under.err;
+}
+
 TEST_F(Cli, PapersAliasesAndLattices) {
   const Result r = run("run --pipeline omp --integrator implicit-euler --lattice 4x3x5 --steps 5 --out " +
                        (dir_ / "lat").string());
