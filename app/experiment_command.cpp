@@ -1,4 +1,3 @@
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -71,7 +70,7 @@ int experiment_command(const ExperimentArgs& a) {
       o.max_size = a.max_size;
       o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
-        const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0;
+        const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0.0;
         std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
@@ -79,8 +78,10 @@ int experiment_command(const ExperimentArgs& a) {
                     << (p.kept ? " (kept)" : "");
         else
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
-        std::cout << "  [" << duration_text(p.elapsed_s) << ", about " << duration_text(std::ceil(left)) << " left]"
-                  << std::endl;
+        std::cout << "  [" << duration_text(p.elapsed_s);
+        // The time left at the rate of the cells run so far: none to go by while only kept cells came.
+        if (p.done < p.total && ran > 0) std::cout << ", about " << duration_text(left) << " left";
+        std::cout << "]" << std::endl;
       };
       nlohmann::json command = a.argv;
       const int ran = run_sweep(x, *sweep, dir, o, command);
