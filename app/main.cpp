@@ -1,6 +1,7 @@
 // deformlab: GPU mass-spring deformation pipelines, measured against a CPU reference.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <limits>
 #include <regex>
 
 #include "commands.hpp"
@@ -39,10 +40,13 @@ void decimal_numbers_only(CLI::App& app) {
       const bool is_int = type.starts_with("INT") || type.starts_with("UINT");
       if (!is_int && !type.starts_with("FLOAT")) continue;
       opt->check(CLI::Validator(
-          [is_int](std::string& v) {
-            return std::regex_match(v, is_int ? integer : real)
-                       ? std::string()
-                       : "'" + v + "' is not " + (is_int ? "a whole decimal number" : "a decimal number");
+          [is_int](std::string& v) -> std::string {
+            if (!std::regex_match(v, is_int ? integer : real))
+              return "'" + v + "' is not " + (is_int ? "a whole decimal number" : "a decimal number");
+            // Every whole-number flag is an int.
+            if (is_int && (v.size() > 12 || std::abs(std::stoll(v)) > std::numeric_limits<int>::max()))
+              return "'" + v + "' is out of range (at most " + std::to_string(std::numeric_limits<int>::max()) + ")";
+            return "";
           },
           ""));
     }
@@ -54,7 +58,7 @@ void decimal_numbers_only(CLI::App& app) {
 
 int main(int argc, char** argv) {
   using deformlab::app::RunArgs;
-  CLI::App cli{"deformlab: mass-spring deformation on CPU, CUDA and GLSL pipelines"};
+  CLI::App cli{"deformlab: mass-spring deformation on CPU, CUDA and GLSL pipelines", "deformlab"};
   cli.require_subcommand(1);
   RunArgs a;
   for (int i = 0; i < argc; ++i) a.argv.emplace_back(argv[i]);
@@ -133,6 +137,26 @@ int main(int argc, char** argv) {
   mesh->add_option("--out,-o", mesh_args.out, "The .msh file to write")->required();
 
   deformlab::app::decimal_numbers_only(cli);
+  // A parse error points to the help of the command it was in.
+  std::string help = "deformlab --help";
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string command = argv[1];
+    bool known = false;
+    std::string names;
+    for (const CLI::App* sub : cli.get_subcommands({})) {
+      known = known || sub->get_name() == command;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (command == "help") {
+      std::cout << cli.help();
+      return 0;
+    }
+    if (!known) {
+      std::cerr << "deformlab: error: unknown command '" << command << "' (valid: " << names << ")\n";
+      return 2;
+    }
+    help = "deformlab " + command + " --help";
+  }
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -140,7 +164,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return cli.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "deformlab: error: " << deformlab::one_line(e.what()) << " (see deformlab --help)\n";
+    std::cerr << "deformlab: error: " << deformlab::one_line(e.what()) << " (see " << help << ")\n";
     return 2;
   }
   if (*run) return deformlab::app::run_command(a);

@@ -101,6 +101,7 @@ void apply_param_flags(const RunArgs& a, Params& p) {
   if (a.threshold && !(std::isfinite(*a.threshold) && *a.threshold > 0 && *a.threshold <= 3e38))
     throw BadInput("--threshold must be a positive finite number of metres");
   if (a.threshold) p.threshold = float(*a.threshold);
+  if (a.check_every && *a.check_every < 1) throw BadInput("--check-every must be at least 1");
   if (a.check_every) p.check_every = *a.check_every;
   if (a.steps) p.max_steps = *a.steps;
   if (a.steps && *a.steps < 1) throw BadInput("--steps must be at least 1");
