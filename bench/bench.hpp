@@ -8,6 +8,7 @@
 
 #include "core/clock_watch.hpp"
 #include "core/pipeline.hpp"
+#include "core/number_text.hpp"
 #include "core/scene.hpp"
 #include "core/timed_work.hpp"
 

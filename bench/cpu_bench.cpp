@@ -15,7 +15,7 @@ void run_cpu(const StepOptions& o) {
   const SceneKind kind = o.scene_kind();
   std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
-            << "method: host steady_clock around each step, " << o.warmup << " warm-up steps, median of "
+            << "method: host steady_clock around each step, " << counted(o.warmup, "warm-up step") << ", median of "
             << o.reps << " timed steps; omp: " << pipelines().find("omp")->summary << "\n\n"
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";

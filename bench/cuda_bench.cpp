@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <utility>
@@ -146,7 +147,7 @@ void run_cuda(const CudaOptions& o) {
             << " SMs, " << fixed(dev.memory_gib, 1) << " GiB), driver " << dev.driver_version << ", runtime "
             << dev.runtime_version << "\n"
             << "method: a CUDA event at each step's end (the pipeline's step clock) after " << warm_up_words(o)
-            << o.warmup << " warm-up steps; the median of steps timed back to back for about "
+            << counted(o.warmup, "warm-up step") << "; the median of steps timed back to back for about "
             << fixed(kGpuTimedMs, 0) << " ms (at least 8), in ms per step.\n"
             << "cloth grid n x n, 12 springs per interior node. " << describe(kind) << ";\n"
             << describe(SceneKind::idealised) << " (graphs; the [fused] summary's second rows).\n"
@@ -296,7 +297,7 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, std::numeric_limits<int>::max()));
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
   c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none or 0: skip)")
       ->expected(0, CLI::detail::expected_max_vector_size)

@@ -151,8 +151,9 @@ void run_gl(const StepOptions& o) {
   std::cout << title("gl") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
-            << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o) << o.warmup
-            << " warm-up steps, the median of steps timed back to back for about " << fixed(kGpuTimedMs, 0)
+            << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o)
+            << counted(o.warmup, "warm-up step")
+            << ", the median of steps timed back to back for about " << fixed(kGpuTimedMs, 0)
             << " ms (at least " << o.reps << ")\n"
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
                "the ceiling of the transform-feedback route\n"

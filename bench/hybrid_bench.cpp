@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "bench.hpp"
@@ -79,7 +80,7 @@ void run_hybrid(const HybridOptions& o) {
   const SceneKind kind = o.scene_kind();
   std::cout << title("hybrid") << " CUDA device " << dev << ", GL " << ctx.renderer << "\n"
             << "cloth n x n, " << describe(kind) << "; " << o.integrator << ", " << warm_up_words(o)
-            << o.warmup << " warm-up steps.\n"
+            << counted(o.warmup, "warm-up step") << ".\n"
             << "gpu: the pipeline's step clock, median per step of steps back to back for about "
             << fixed(kGpuTimedMs, 0) << " ms (at least\n"
             << o.steps << "; CUDA events for cuda-fused, GL timer queries for glsl-tf and the hybrids, whose GL\n"
@@ -175,7 +176,7 @@ void add_hybrid_bench(CLI::App& app) {
   c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
   c->add_option("--updates", o->updates, "Update passes: tf, compute");
   c->add_option("--steps", o->steps, "Timed steps at the least (more where they take under 200 ms)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, std::numeric_limits<int>::max()));
   c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
   c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
   c->callback([o] { run_hybrid(*o); });

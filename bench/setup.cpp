@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -78,7 +79,7 @@ std::string fixed(double v, int prec) {
 
 Integrator BenchOptions::integ() const {
   const auto i = parse_integrator(integrator);
-  if (!i) throw std::invalid_argument("unknown integrator " + integrator);
+  if (!i) throw std::invalid_argument("unknown integrator '" + integrator + "' (valid: " + integrator_names() + ")");
   return *i;
 }
 
@@ -86,7 +87,7 @@ void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
   c.add_flag("--idealised", o.idealised,
              "Time the idealised scene (undamped, no contact, no drag) in place of the paper's (table2's)");
-  c.add_option("--warmup", o.warmup, "Warm-up steps")->check(CLI::PositiveNumber);
+  c.add_option("--warmup", o.warmup, "Warm-up steps (0: none)")->check(CLI::Range(0, std::numeric_limits<int>::max()));
   c.add_option("--integrator", o.integrator, "Integrator");
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");
 }
@@ -117,7 +118,7 @@ void add_step_bench(CLI::App& app, const char* name, const char* description, st
   o->reps = reps;
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
-  c->add_option("--reps", o->reps, reps_help)->check(CLI::PositiveNumber);
+  c->add_option("--reps", o->reps, reps_help)->check(CLI::Range(1, std::numeric_limits<int>::max()));
   if (device == Device::gpu) add_warmup_ms(*c, *o);
   c->callback([o, run] { run(*o); });
 }
