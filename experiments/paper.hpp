@@ -19,5 +19,7 @@ struct Ratio {
   std::string num, den, label;
 };
 const std::vector<Ratio>& ratios(const std::string& table);
+// What a reader of the table's paper figures should know ("" for none).
+std::string note(const std::string& table);
 
 }  // namespace deformlab::paper

@@ -276,6 +276,7 @@ void write_table(Report& r, const Table& t) {
                         (paper ? " (dashed: paper, ms per frame)" : "");
   plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes", y, series);
   r.md << "\n![" << t.title << "](" << svg << ")\n\n";
+  if (const std::string note = paper::note(r.sweep.paper_table); !note.empty() && !pcols.empty()) r.md << note << "\n\n";
   if (r.ceil.any() && r.sweep.time == "update") write_ceiling_table(r.md, t.columns, r.results, r.ceil);
 }
 
