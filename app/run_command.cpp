@@ -191,9 +191,15 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
     std::cout << "  option " << name << "=" << value << ": chosen for this machine (none given)\n";
   for (const auto& line : m.repairs) std::cout << "  mesh: " << line << "\n";
   std::cout << "  steps: " << r.steps << " (" << r.steps * double(in.params.dt) << " s simulated); ";
-  if (in.until_converged)
-    std::cout << (r.converged ? "converged: no node moved more than " : "not converged within max_steps; threshold ")
-              << in.params.threshold << " m in the last step\n";
+  if (r.converged)
+    std::cout << "converged: no node moved more than " << in.params.threshold << " m in the last step\n";
+  else if (in.until_converged && r.steps < first_stop_step(in.params))
+    std::cout << "not converged: the stop rule starts at step " << first_stop_step(in.params)
+              << " (min_steps and the drag path's end), after max_steps\n";
+  else if (in.until_converged)
+    std::cout << "not converged by max_steps: the last check found a node moving "
+              << significant_trimmed(r.last_displacement, 3) << " m in a step, over the threshold "
+              << in.params.threshold << " m\n";
   else
     std::cout << "fixed step count\n";
   std::cout << "  time: median " << significant(med.step_ms, 4) << " ms/step (" << r.clock << "), "

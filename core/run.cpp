@@ -1,6 +1,7 @@
 #include "run.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -113,11 +114,19 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   return os.str();
 }
 
+int first_stop_step(const Params& p) {
+  const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
+  int step = std::max(p.min_steps, 1);
+  if (step * double(p.dt) < drag_end) step = int(std::ceil(drag_end / double(p.dt)));
+  while (step * double(p.dt) < drag_end) ++step;  // the quotient rounded down
+  return step;
+}
+
 RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions& opt) {
   using clock = std::chrono::steady_clock;
   RunResult r;
   r.records.reserve(std::size_t(std::min(p.max_steps, 1 << 20)));
-  const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
+  const int first_stop = first_stop_step(p);
   const float extent = m.extent();
   // A check waits for its step where the pipeline cannot step back, each step is looked at
   // (after_step) or checks fall between launches; else it is read while the next launch runs
@@ -132,7 +141,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     r.last_displacement = disp;
     if (const std::string why = divergence(disp, extent, m, p, opt.integrator, step, t); !why.empty())
       throw DivergenceError(step, why);
-    return opt.until_converged && step >= p.min_steps && t >= drag_end && disp < p.threshold;
+    return opt.until_converged && step >= first_stop && disp < p.threshold;
   };
   pipe.set_profiler(opt.profiler);
   StepTimes times(pipe, r, opt.profiler);

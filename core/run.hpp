@@ -56,6 +56,10 @@ struct RunResult {
   std::vector<StepRecord> records;
 };
 
+// The first step at which the stop rule may end a convergence run: from min_steps on, once
+// the drag path has ended.
+int first_stop_step(const Params& p);
+
 struct RunOptions {
   bool until_converged = false;  // else run exactly params.max_steps steps
   // Called after every step (e.g. to write frames); may be empty. When set, each check waits
