@@ -88,7 +88,10 @@ Experiment parse_experiment(const std::string& text, const std::string& where, c
 }
 
 Experiment load_experiment(const std::string& path) {
-  return from_json(read_json_file(path, "experiment file"), path, std::filesystem::path(path).parent_path().string());
+  Experiment x = from_json(read_json_file(path, "experiment file"), path, std::filesystem::path(path).parent_path().string());
+  if (const std::string stem = std::filesystem::path(path).stem().string(); x.name.empty() && is_plain_name(stem))
+    x.name = stem;
+  return x;
 }
 
 Experiment load_experiment_by_name(const std::string& path_or_name) {
@@ -103,10 +106,13 @@ Experiment load_experiment_by_name(const std::string& path_or_name) {
   return load_experiment(path_or_name);
 }
 
-std::string builtin_experiment_names() {
+std::string builtin_experiment_names(bool sweeps_only) {
   std::string names;
-  for (std::string_view file : experiment_files::names())
-    if (file.ends_with(".json")) names += (names.empty() ? "" : ", ") + std::string(file.substr(0, file.size() - 5));
+  for (std::string_view file : experiment_files::names()) {
+    if (!file.ends_with(".json")) continue;
+    if (sweeps_only && !json::parse(*experiment_files::find(file)).contains("sweep")) continue;
+    names += (names.empty() ? "" : ", ") + std::string(file.substr(0, file.size() - 5));
+  }
   return names;
 }
 

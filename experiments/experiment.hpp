@@ -29,11 +29,12 @@ Experiment parse_experiment(const std::string& text, const std::string& where, c
 Experiment load_experiment(const std::string& path);
 // A path to an experiment file, or the name of one built into the binary ("table1"). A
 // built-in experiment's mesh files are taken from the source tree's data/ (builtin_data_dir).
+// A file without a "name" is named by its file name without ".json", where that is a plain name.
 // A name that is neither is bad input naming the built-in ones.
 Experiment load_experiment_by_name(const std::string& path_or_name);
 // The names of the experiments built into the binary (experiments/*.json), comma-separated:
-// "gl-memory, interop, ...".
-std::string builtin_experiment_names();
+// "gl-memory, interop, ..."; with `sweeps_only`, those with a sweep (`deformlab experiment`'s).
+std::string builtin_experiment_names(bool sweeps_only = false);
 // The data/ folder of the source tree this binary was built in: the first folder above the
 // running executable that holds data/ and experiments/ (a build inside a tree, wherever the
 // tree was moved), else the source tree it was configured from.

@@ -194,6 +194,22 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
   for (std::string n; std::getline(list >> std::ws, n, ',');) named.insert(n);
   EXPECT_EQ(named, files);
   for (const std::string& n : files) EXPECT_EQ(load_experiment_by_name(n).name, n);
+  // `deformlab experiment`'s help names those with a sweep.
+  std::set<std::string> swept;
+  std::stringstream sweeps(builtin_experiment_names(true));
+  for (std::string n; std::getline(sweeps >> std::ws, n, ',');) swept.insert(n);
+  for (const std::string& n : files)
+    EXPECT_EQ(swept.count(n), std::size_t(load_experiment_by_name(n).raw.contains("sweep"))) << n;
+  EXPECT_EQ(swept.count("paper-drag"), 0u);
+}
+
+// A file without a "name" is named by its file name, as its results folder is.
+TEST_F(SweepTest, AFileWithoutANameIsNamedByItsFile) {
+  fs::create_directories(dir_);
+  std::ofstream(dir_ / "my-drag.json") << R"({"base": "paper-drag"})";
+  EXPECT_EQ(load_experiment_by_name((dir_ / "my-drag.json").string()).name, "my-drag");
+  std::ofstream(dir_ / "named.json") << R"({"name": "other", "base": "paper-drag"})";
+  EXPECT_EQ(load_experiment_by_name((dir_ / "named.json").string()).name, "other");
 }
 
 TEST(Sweep, TakesTheIntegratorOfItsExperimentsBase) {
