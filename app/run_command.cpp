@@ -216,12 +216,14 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   // A stage seen in fewer steps than those sampled (the checks of a run that checks rarely, whose
   // last one waits for the queued steps; cuda-temporal's launches) says in how many.
   const int sampled = profiler.sampled_count(r.steps);
-  for (const auto& g : profiler.summary()) {
+  auto stages = profiler.summary();  // the whole step last, below its parts
+  std::stable_partition(stages.begin(), stages.end(), [](const auto& g) { return g.name != span::step; });
+  for (const auto& g : stages) {
     // A GPU pipeline's check is the host waiting for the device's work, then reading its result.
     const bool waits = on_gpu(*in.entry) && g.name == span::reductions;
-    std::cout << "    " << std::left << std::setw(12) << g.name << std::right << std::setw(11)
-              << significant(g.median_ms, 4) << " ms  (" << g.clock << (waits ? ", waiting for the device" : "");
-    if (g.steps < sampled) std::cout << "; in " << g.steps << (g.steps == 1 ? " step" : " steps");
+    std::cout << "    " << std::left << std::setw(13) << g.name << std::right << std::setw(9)
+              << duration_text(g.median_ms / 1000.0) << "  (" << g.clock << (waits ? ", waiting for the device" : "");
+    if (g.steps < sampled) std::cout << "; in " << counted(g.steps, "step");
     std::cout << ")\n";
   }
   const json mem = memory_of(in);

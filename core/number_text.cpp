@@ -31,8 +31,10 @@ std::string duration_text(double s) {
   if (s == 0) return "0 s";
   // Each unit up to where its three digits would round to 1000 (or to a minute).
   if (s < 59.95) {
-    const auto [scale, unit] =
-        s < 999.5e-6 ? std::pair{1e6, " µs"} : s < 0.9995 ? std::pair{1e3, " ms"} : std::pair{1.0, " s"};
+    const auto [scale, unit] = s < 999.5e-9   ? std::pair{1e9, " ns"}
+                               : s < 999.5e-6 ? std::pair{1e6, " µs"}
+                               : s < 0.9995   ? std::pair{1e3, " ms"}
+                                              : std::pair{1.0, " s"};
     return significant(s * scale, 3) + unit;
   }
   const long r = std::lround(s);

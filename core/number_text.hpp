@@ -11,7 +11,7 @@ namespace deformlab {
 std::string significant(double v, int digits);
 // The same without trailing zeros (as %g writes it, never with an exponent): 0.5, 0.000043.
 std::string significant_trimmed(double v, int digits);
-// A duration of `s` seconds: "45.3 µs", "9.06 ms", "1.23 s", "2 min 03 s", "1 h 02 min".
+// A duration of `s` seconds: "69.0 ns", "45.3 µs", "9.06 ms", "1.23 s", "2 min 03 s", "1 h 02 min".
 std::string duration_text(double s);
 // "1 node", "4096 nodes"; `plural` where adding "s" is wrong.
 std::string counted(std::int64_t n, std::string_view noun, std::string_view plural = {});

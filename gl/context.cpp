@@ -365,7 +365,7 @@ std::vector<double> Timer::take() {
 }
 
 std::string Timer::method() const {
-  return software_ ? "host clock after glFinish (software OpenGL; its timer queries are not meaningful)"
+  return software_ ? "host clock after glFinish, as software OpenGL's timer queries mean nothing"
                    : "GL timer queries (GL_TIMESTAMP)";
 }
 

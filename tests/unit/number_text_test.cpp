@@ -30,6 +30,8 @@ TEST(NumberText, SignificantDigitsNeverUseAnExponent) {
 
 TEST(NumberText, DurationsTakeTheUnitThatSuitsThem) {
   EXPECT_EQ(duration_text(0), "0 s");
+  EXPECT_EQ(duration_text(6.9e-08), "69.0 ns");
+  EXPECT_EQ(duration_text(9.9996e-07), "1.00 µs");
   EXPECT_EQ(duration_text(4.532e-05), "45.3 µs");
   EXPECT_EQ(duration_text(0.009062), "9.06 ms");
   EXPECT_EQ(duration_text(0.9996), "1.00 s");
