@@ -1,5 +1,6 @@
 #include "number_text.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -24,6 +25,14 @@ std::string significant_trimmed(double v, int digits) {
   while (s.back() == '0') s.pop_back();
   if (s.back() == '.') s.pop_back();
   return s;
+}
+
+double shortest_decimal(float f) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, f).ptr;
+  double d = 0;
+  std::from_chars(text, end, d);
+  return float(d) == f ? d : double(f);
 }
 
 std::string duration_text(double s) {

@@ -1,12 +1,13 @@
 #include "run.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <utility>
 
+#include "number_text.hpp"
 #include "springs.hpp"
 
 namespace deformlab {
@@ -157,7 +158,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     times.end();
     const double queue_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     r.steps = step;
-    r.records.push_back({step, step * double(p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
+    r.records.push_back({step, step * shortest_decimal(p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
                          std::numeric_limits<double>::quiet_NaN()});
     if (queued && step == queued + launch) {  // the check before this launch, read while it runs
       const int checked = std::exchange(queued, 0);

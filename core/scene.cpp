@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -14,6 +13,7 @@
 
 #include "json_file.hpp"
 #include "memory.hpp"
+#include "number_text.hpp"
 
 namespace deformlab {
 
@@ -473,18 +473,12 @@ std::string describe(const ModelSpec& m) {
 namespace {
 
 // Every number of `j` that is a float's value written as that float's shortest decimal (0.002,
-// not the double 0.0020000000949949026), where that decimal reads back as the same float (read
-// as a double first, a few do not: those keep their exact value).
+// not the double 0.0020000000949949026; shortest_decimal).
 void shortest_floats(json& j) {
   if (j.is_structured()) {
     for (auto& v : j) shortest_floats(v);
   } else if (j.is_number_float() && double(float(j.get<double>())) == j.get<double>()) {
-    const float f = float(j.get<double>());
-    char text[32];
-    const auto end = std::to_chars(text, text + sizeof text, f).ptr;
-    double d = 0;
-    std::from_chars(text, end, d);
-    if (float(d) == f) j = d;
+    j = shortest_decimal(float(j.get<double>()));
   }
 }
 

@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "core/number_text.hpp"
 #include "core/one_line.hpp"
 #include "core/run.hpp"
 #include "core/write_error.hpp"
@@ -387,7 +388,7 @@ class Viewer {
     summary_["pipeline"] = s_.entry().name;
     summary_["drawn_from"] = drawn_from_;
     summary_["integrator"] = info(s_.integrator()).name;
-    summary_["dt"] = s_.params().dt;
+    summary_["dt"] = shortest_decimal(s_.params().dt);
     summary_["largest_move_m"] = moved;  // of any node since the viewer opened
     try {
       write_file(o_.summary, [&](std::ostream& out) { out << summary_.dump(1) << "\n"; });

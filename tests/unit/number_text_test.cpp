@@ -28,6 +28,14 @@ TEST(NumberText, SignificantDigitsNeverUseAnExponent) {
   EXPECT_EQ(significant_trimmed(0.999999, 3), "1");
 }
 
+// A float as the decimal it was written as: 0.002, not 0.0020000000949949026.
+TEST(NumberText, AFloatsShortestDecimal) {
+  EXPECT_EQ(shortest_decimal(0.002f), 0.002);
+  EXPECT_EQ(shortest_decimal(1e-5f), 1e-5);
+  EXPECT_EQ(float(shortest_decimal(0.1f)), 0.1f);
+  for (float f : {0.002f, 3e38f, 1.17549435e-38f, 16777217.0f, 0.3f}) EXPECT_EQ(float(shortest_decimal(f)), f) << f;
+}
+
 TEST(NumberText, DurationsTakeTheUnitThatSuitsThem) {
   EXPECT_EQ(duration_text(0), "0 s");
   EXPECT_EQ(duration_text(6.9e-08), "69.0 ns");

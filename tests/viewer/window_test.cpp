@@ -98,7 +98,7 @@ TEST_F(View, SavedSessionReplaysToTheSameState) {
   ASSERT_EQ(a["drags"].size(), 1u) << a.dump();
   EXPECT_EQ(a["drags"], b["drags"]);
   EXPECT_EQ(a["largest_move_m"], b["largest_move_m"]) << "the same steps from the same input";
-  EXPECT_EQ(b["dt"], 0.001f);
+  EXPECT_EQ(b["dt"], 0.001) << "the float dt as the decimal given";
   EXPECT_EQ(b["steps"], (16 - 2) * 3) << "two frames paused";
 }
 
