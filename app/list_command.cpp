@@ -51,7 +51,8 @@ int list_command() {
   std::cout << "\nIntegrators (name, the paper's name also accepted, force passes per step, order):\n";
   for (const auto& i : integrators())
     std::cout << "  " << std::left << std::setw(21) << i.name << std::setw(18)
-              << (i.paper_alias.empty() ? "-" : std::string(i.paper_alias)) << i.force_passes << "  " << i.order
+              << (i.paper_alias.empty() ? "-" : std::string(i.paper_alias)) << std::setw(10)
+              << (std::to_string(i.force_passes) + (i.id == Integrator::backward_euler ? " + solve" : "")) << i.order
               << "  " << i.summary << "\n";
   return 0;
 }
