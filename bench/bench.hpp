@@ -77,7 +77,14 @@ std::string warm_up_words(const BenchOptions& o);
 
 // The CSV file at `path` with its header line written; not open when `path` is empty.
 // Throws std::invalid_argument when it cannot be written.
-std::ofstream open_csv(const std::string& path, const char* header);
+// The columns each CSV row of a bench ends with, so that a file says what it measured: the
+// build, and where the bench runs one scene and integrator, those first. Their names end the
+// header (`tail`: kRunColumns or kBuildColumn); the rows' values are run_columns / build_column.
+inline constexpr const char* kRunColumns = ",scene,integrator,build";
+inline constexpr const char* kBuildColumn = ",build";
+std::string run_columns(const BenchOptions& o);
+std::string build_column();
+std::ofstream open_csv(const std::string& path, const char* header, const char* tail);
 
 // What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.
 struct StepOptions : BenchOptions {

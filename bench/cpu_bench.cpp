@@ -13,13 +13,13 @@ namespace {
 void run_cpu(const StepOptions& o) {
   const Integrator integ = o.integ();
   const SceneKind kind = o.scene_kind();
+  std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms", kRunColumns);
   std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "method: host steady_clock around each step, " << counted(o.warmup, "warm-up step") << ", median of "
             << o.reps << " timed steps; omp: " << pipelines().find("omp")->summary << "\n\n"
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
-  std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms");
   for (int n : o.sizes) {
     const BenchScene scene(n, kind);
     const Model& m = scene.model;
@@ -30,7 +30,7 @@ void run_cpu(const StepOptions& o) {
       timed_steps(*pipe, *timer, o.warmup);
       st[k] = stats(timed_steps(*pipe, *timer, o.reps));
       if (csv) csv << n << "x" << n << "," << m.node_count() << "," << (k ? "omp" : "cpu") << "," << st[k].median
-                   << "," << st[k].min << "," << st[k].p90 << "\n";
+                   << "," << st[k].min << "," << st[k].p90 << run_columns(o) << "\n";
     }
     std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(12)
               << st[0].median << std::setw(12) << st[1].median << std::setw(10) << std::setprecision(2)

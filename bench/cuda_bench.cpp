@@ -54,7 +54,8 @@ class Report {
       : copy_gbs_(copy_gbs),
         bus_(std::move(bus)),
         csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
-                             "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction")) {}
+                             "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction",
+                      kBuildColumn)) {}
   Row measure(const std::string& table, SceneKind kind, const BenchScene& scene, Integrator integ,
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
@@ -117,7 +118,7 @@ class Report {
       csv_ << r.table << "," << r.scene << "," << r.grid << "," << r.nodes << "," << r.variant << "," << r.integrator
            << "," << r.tile << "," << r.math << "," << steps_per_launch << "," << r.graphs << "," << r.ms << ","
            << r.floor_bytes << "," << r.gbs << "," << r.of_copy << ","
-           << clock_columns(r.clock) << "\n";
+           << clock_columns(r.clock) << build_column() << "\n";
     return r;
   }
 

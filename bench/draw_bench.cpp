@@ -24,15 +24,16 @@ const char* to_string(Route r) {
 void run_draw(const StepOptions& o) {
   const gl::ContextInfo& ctx = gl::context();
   const Integrator integ = o.integ();
+  std::ofstream csv =
+      open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms,sm_mhz_median,slowed_fraction", kRunColumns);
   std::cout << title("draw") << " GL " << ctx.renderer << "; cloth n x n, " << describe(o.scene_kind())
             << ", drawn 1280 x 800 as a surface.\n"
             << "frame: host clock from a drained device (the pipeline's last step done) to glFinish after the draw,\n"
             << "the state's hand-over included; draw: the draw alone on " << gl::Timer().method() << ".\n"
-            << "Medians of " << o.reps << " frames after " << warm_up_words(o) << o.warmup
-            << " warm-up frames, ms.\n\n"
+            << "Medians of " << o.reps << " frames after " << warm_up_words(o)
+            << counted(o.warmup, "warm-up frame") << ", ms.\n\n"
             << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(22) << "route" << std::setw(11)
             << "frame ms" << std::setw(10) << "draw ms" << "\n";
-  std::ofstream csv = open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms,sm_mhz_median,slowed_fraction");
   ClockTally clocks;
   const std::pair<const char*, Route> cases[] = {{"glsl-compute", Route::own_buffer},
                                                  {"hybrid-compute", Route::own_buffer},
@@ -44,7 +45,8 @@ void run_draw(const StepOptions& o) {
     for (const auto& [name, route] : cases) {
       const PipelineEntry& e = *pipelines().find(name);
       if (const std::string why = e.unavailable(); !why.empty()) {
-        std::cout << std::setw(6) << n << std::setw(16) << name << "  unavailable: " << why << "\n";
+        std::cout << std::setw(6) << n << std::setw(16) << name << std::setw(22) << to_string(route)
+                  << "  unavailable: " << why << "\n";
         continue;
       }
       auto p = e.make(scene.setup(integ));
@@ -75,7 +77,7 @@ void run_draw(const StepOptions& o) {
                 << fixed(frame, 3) << std::setw(10) << fixed(draw, 3) << std::endl;
       if (csv)
         csv << n << "," << name << "," << to_string(route) << "," << frame << "," << draw << "," << clock_columns(clock)
-            << "\n";
+            << run_columns(o) << "\n";
     }
   }
   print_clocks(std::cout, clocks, "timed frames");

@@ -148,6 +148,8 @@ void run_gl(const StepOptions& o) {
   const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
   const SceneKind kind = o.scene_kind();
+  std::ofstream csv =
+      open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms,sm_mhz_median,slowed_fraction", kRunColumns);
   std::cout << title("gl") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
@@ -162,7 +164,6 @@ void run_gl(const StepOptions& o) {
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
             << std::setw(14) << "tf/ceiling" << std::setw(14) << "bare gather" << std::setw(15) << "compute exact"
             << std::setw(14) << "compute fast" << std::setw(12) << "fast/bare" << "\n";
-  std::ofstream csv = open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms,sm_mhz_median,slowed_fraction");
   ClockTally clocks;
   std::string memory;  // where the node buffers live, as the registry's pipelines chose
   // The registry's pipelines, as `deformlab run` makes them.
@@ -208,7 +209,7 @@ void run_gl(const StepOptions& o) {
       if (csv)
         csv << '"' << ctx.renderer << "\"," << n << "x" << n << "," << m.node_count() << "," << what << ","
             << s.median << "," << s.min << "," << s.p90 << ","
-            << clock_columns(s.clock) << "\n";
+            << clock_columns(s.clock) << run_columns(o) << "\n";
     }
   }
   if (!memory.empty())

@@ -93,7 +93,8 @@ void run_hybrid(const HybridOptions& o) {
             << "(update + force + " << 2 * passes << " floors).\n\n";
   std::ofstream csv = open_csv(o.csv,
                                "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,"
-                               "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction");
+                               "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction",
+                               kRunColumns);
   std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
             << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
             << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)
@@ -109,7 +110,7 @@ void run_hybrid(const HybridOptions& o) {
     if (csv)
       csv << r.n << "," << r.pipeline << "," << r.mode << "," << r.wall_ms << "," << r.host_ms << "," << r.gpu_ms << ","
           << r.force_ms << "," << r.update_ms << "," << r.hand_off_us << "," << r.hand_off_host_us << "," << floor_us
-          << "," << clock_columns(r.clock) << "\n";
+          << "," << clock_columns(r.clock) << run_columns(o) << "\n";
   };
 
   const std::string bus = cuda::device_info(dev).pci_bus_id;

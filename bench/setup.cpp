@@ -84,11 +84,14 @@ Integrator BenchOptions::integ() const {
 }
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
-  c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)");
+  c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)")->check(CLI::Range(1, 1 << 17));
   c.add_flag("--idealised", o.idealised,
              "Time the idealised scene (undamped, no contact, no drag) in place of the paper's (table2's)");
   c.add_option("--warmup", o.warmup, "Warm-up steps (0: none)")->check(CLI::Range(0, std::numeric_limits<int>::max()));
-  c.add_option("--integrator", o.integrator, "Integrator");
+  c.add_option("--integrator", o.integrator, "Integrator")->transform([](std::string name) {
+    const auto i = parse_integrator(name);  // the paper's aliases by their names
+    return i ? std::string(info(*i).name) : name;
+  });
   c.add_option("--csv", o.csv, "Also write the results to this CSV file");
 }
 
@@ -101,12 +104,18 @@ std::string warm_up_words(const BenchOptions& o) {
   return o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of untimed steps from rest (host clock), then " : "";
 }
 
-std::ofstream open_csv(const std::string& path, const char* header) {
+std::string build_column() { return "," + build_info()["git"].get<std::string>(); }
+
+std::string run_columns(const BenchOptions& o) {
+  return std::string(",") + to_string(o.scene_kind()) + "," + o.integrator + build_column();
+}
+
+std::ofstream open_csv(const std::string& path, const char* header, const char* tail) {
   std::ofstream csv;
   if (path.empty()) return csv;
   csv.open(path);
   if (!csv) throw std::invalid_argument("cannot write " + path);
-  csv << header << "\n";
+  csv << header << tail << "\n";
   return csv;
 }
 
