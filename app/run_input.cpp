@@ -208,7 +208,9 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
   std::stringstream ss(s);
   for (std::string part; std::getline(ss, part, 'x');) {
     if (part.empty() || !std::all_of(part.begin(), part.end(), ::isdigit))
-      throw std::invalid_argument(std::string(flag) + " '" + s + "': expected " + pat + " with positive integers");
+      throw std::invalid_argument(std::string(flag) + " '" + s + "': expected " + pat +
+                                  ", positive whole numbers joined by a lower-case x (" +
+                                  (dims == 2 ? "128x128" : "16x16x16") + ")");
     const long long v = std::stoll(part.size() > 12 ? std::string("9999999999999") : part);
     if (v <= 0 || v > 1'000'000'000)
       throw std::invalid_argument(std::string(flag) + " '" + s + "': each size must be between 1 and 10^9");

@@ -161,7 +161,7 @@ void write_method(Report& r) {
   if (method.empty()) return;
   r.md << "- Method: " << method << ". "
        << (r.sweep.time == "frame" ? "Times are milliseconds per frame (update and a 1024 x 1024 draw), as the paper's.\n"
-                                   : "Times are milliseconds per simulation step (update only); the paper's are "
+                                   : "Times are milliseconds per simulation step (no rendering); the paper's are "
                                      "milliseconds per frame, update and rendering.\n");
   if (!clocks.empty()) {
     r.md << "- Step clocks:";
