@@ -1,11 +1,10 @@
 // deformlab: GPU mass-spring deformation pipelines, measured against a CPU reference.
 #include <CLI/CLI.hpp>
 #include <iostream>
-#include <limits>
-#include <regex>
 
 #include "commands.hpp"
 #include "core/one_line.hpp"
+#include "decimal_flags.hpp"
 #include "experiments/experiment.hpp"
 
 namespace deformlab::app {
@@ -24,35 +23,6 @@ int report_errors(const std::function<int()>& body) {
     return 1;
   }
 }
-
-namespace {
-
-// CLI11 reads "0x10" as 16 (and "0b11" into some types): a number on the command line is taken
-// only as a decimal, so that a typo is refused rather than read as another base. The words nan
-// and inf pass to the options' own range checks, which name what the option takes.
-void decimal_numbers_only(CLI::App& app) {
-  static const std::regex integer(R"([+-]?[0-9]+)");
-  static const std::regex real(R"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?|[+-]?(nan|inf|infinity))",
-                               std::regex::icase);
-  for (CLI::App* sub : app.get_subcommands({}))
-    for (CLI::Option* opt : sub->get_options()) {
-      const std::string type = opt->get_type_name();  // "INT", or "INT:" and a check's description
-      const bool is_int = type.starts_with("INT") || type.starts_with("UINT");
-      if (!is_int && !type.starts_with("FLOAT")) continue;
-      opt->check(CLI::Validator(
-          [is_int](std::string& v) -> std::string {
-            if (!std::regex_match(v, is_int ? integer : real))
-              return "'" + v + "' is not " + (is_int ? "a whole decimal number" : "a decimal number");
-            // Every whole-number flag is an int.
-            if (is_int && (v.size() > 12 || std::abs(std::stoll(v)) > std::numeric_limits<int>::max()))
-              return "'" + v + "' is out of range (at most " + std::to_string(std::numeric_limits<int>::max()) + ")";
-            return "";
-          },
-          ""));
-    }
-}
-
-}  // namespace
 
 }  // namespace deformlab::app
 

@@ -1,6 +1,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -151,7 +152,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"setup", {{"model_build_s", in.build_s}, {"pipeline_setup_s", setup_s}, {"clock", "host steady_clock"}}},
       {"warm_up", {{"steps", ran.warm_up.steps}, {"ms", ran.warm_up.ms}, {"clock", "host steady_clock"},
                    {"what", "untimed steps from rest before the run, which then starts from rest"}}},
-      {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", r.steps * shortest_decimal(in.params.dt)},
+      {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", std::round(r.steps * shortest_decimal(in.params.dt) * 1e9) / 1e9},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"wall_ms", r.wall_ms}, {"wall_clock", "host steady_clock from the first step to the device's end "
                                                          "of the last, checks and frames included"},
@@ -193,14 +194,15 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   std::cout << "  steps: " << r.steps << " (" << significant_trimmed(r.steps * shortest_decimal(in.params.dt), 6)
             << " s simulated); ";
   if (r.converged)
-    std::cout << "converged: no node moved more than " << in.params.threshold << " m in the last step\n";
+    std::cout << "converged: no node moved more than " << significant_trimmed(in.params.threshold, 3)
+              << " m in the last step\n";
   else if (in.until_converged && r.steps < first_stop_step(in.params))
     std::cout << "not converged: the stop rule starts at step " << first_stop_step(in.params)
               << " (min_steps and the drag path's end), after max_steps\n";
   else if (in.until_converged)
     std::cout << "not converged by max_steps: the last check found a node moving "
               << significant_trimmed(r.last_displacement, 3) << " m in a step, over the threshold "
-              << in.params.threshold << " m\n";
+              << significant_trimmed(in.params.threshold, 3) << " m\n";
   else
     std::cout << "fixed step count\n";
   std::cout << "  time: median " << significant(med.step_ms, 4) << " ms/step (" << r.clock << "), "
@@ -222,8 +224,10 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   for (const auto& g : stages) {
     // A GPU pipeline's check is the host waiting for the device's work, then reading its result.
     const bool waits = on_gpu(*in.entry) && g.name == span::reductions;
-    std::cout << "    " << std::left << std::setw(13) << g.name << std::right << std::setw(9)
-              << duration_text(g.median_ms / 1000.0) << "  (" << g.clock << (waits ? ", waiting for the device" : "");
+    const std::string time = duration_text(g.median_ms / 1000.0);  // "µs" takes 3 bytes for 2 places
+    const auto places = std::count_if(time.begin(), time.end(), [](char c) { return (c & 0xC0) != 0x80; });
+    std::cout << "    " << std::left << std::setw(13) << g.name << std::string(std::max(0L, 9 - long(places)), ' ')
+              << time << "  (" << g.clock << (waits ? ", waiting for the device" : "");
     if (g.steps < sampled) std::cout << "; in " << counted(g.steps, "step");
     std::cout << ")\n";
   }

@@ -50,12 +50,14 @@ struct Row {
 
 class Report {
  public:
-  Report(const CudaOptions& o, double copy_gbs, std::string bus)
-      : copy_gbs_(copy_gbs),
-        bus_(std::move(bus)),
-        csv_(open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
-                             "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction",
-                      kBuildColumn)) {}
+  // `csv`: open_csv_of's, opened before anything is measured.
+  Report(double copy_gbs, std::string bus, std::ofstream csv)
+      : copy_gbs_(copy_gbs), bus_(std::move(bus)), csv_(std::move(csv)) {}
+  static std::ofstream open_csv_of(const CudaOptions& o) {
+    return open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
+                           "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction",
+                    kBuildColumn);
+  }
   Row measure(const std::string& table, SceneKind kind, const BenchScene& scene, Integrator integ,
               const cuda::Options& opt, const CudaOptions& o) {
     const Model& m = scene.model;
@@ -139,6 +141,7 @@ void run_cuda(const CudaOptions& o) {
   // Asked of a machine without CUDA: refused like deformlab's CUDA pipelines there (exit 2).
   if (const std::string why = cuda::unavailable(); !why.empty()) throw std::invalid_argument(why);
 
+  std::ofstream csv = Report::open_csv_of(o);
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
   const TimedWork copy_work = cuda::time_copy(copy_bytes, 20, o.warmup_ms);
@@ -159,7 +162,7 @@ void run_cuda(const CudaOptions& o) {
             << fixed(copy, 3) << " ms = " << fixed(copy_gbs, 0)
             << " GB/s counting read + write (the memory ceiling of this run).\n";
 
-  Report rep(o, copy_gbs, dev.pci_bus_id);
+  Report rep(copy_gbs, dev.pci_bus_id, std::move(csv));
   rep.clocks().add("copy " + std::to_string(o.copy_mib) + " MiB", copy_work.clock);
   std::cout << "\n[steps] " << to_string(kind) << " scene, " << o.integrator << ", exact math, default tiles, step "
                "graphs on\n"

@@ -71,6 +71,10 @@ void run_hybrid(const HybridOptions& o) {
   const gl::ContextInfo& ctx = gl::context();
   const int dev = interop::cuda_device_of_gl();
   const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();
+  std::ofstream csv = open_csv(o.csv,
+                               "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,"
+                               "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction",
+                               kRunColumns);
   // The floor's ping-pong does no work: copies for o.warmup_ms raise the device's clock first, as
   // the cases' warm-ups do (their times are not used).
   const bool measure_floor = std::isnan(o.floor_us) && gpusync;
@@ -91,10 +95,6 @@ void run_hybrid(const HybridOptions& o) {
             << "(" << 2 * passes << "); ho-host: host clock inside the hand-off calls per step. floor: GL<->CUDA\n"
             << "semaphore ping-pong with no work, " << fixed(floor_us, 1) << " us per hand-off. bound: wall <= 1.05 x\n"
             << "(update + force + " << 2 * passes << " floors).\n\n";
-  std::ofstream csv = open_csv(o.csv,
-                               "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,"
-                               "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction",
-                               kRunColumns);
   std::cout << std::setw(6) << "n" << std::setw(16) << "pipeline" << std::setw(18) << "mode" << std::setw(10) << "wall ms"
             << std::setw(10) << "host ms" << std::setw(10) << "gpu ms" << std::setw(10) << "force ms" << std::setw(11)
             << "update ms" << std::setw(13) << "hand-off us" << std::setw(10) << "x floor" << std::setw(13)

@@ -1,6 +1,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "app/decimal_flags.hpp"
 #include "bench.hpp"
 #include "core/one_line.hpp"
 
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   deformlab::bench::add_hybrid_bench(cli);
   deformlab::bench::add_draw_bench(cli);
 #endif
+  deformlab::app::decimal_numbers_only(cli);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

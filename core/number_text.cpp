@@ -1,5 +1,6 @@
 #include "number_text.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -8,14 +9,15 @@ namespace deformlab {
 
 std::string significant(double v, int digits) {
   if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
-  char out[64];
   if (v == 0) return "0";
   // Round first, so that 9.9996 to 4 digits counts its decimals from 10.00, not 9.9996.
   const int exponent = int(std::floor(std::log10(std::fabs(v))));
   int decimals = digits - 1 - exponent;
   const double rounded = decimals >= 0 ? std::round(v * std::pow(10.0, decimals)) / std::pow(10.0, decimals) : v;
   if (rounded != 0 && int(std::floor(std::log10(std::fabs(rounded)))) > exponent) --decimals;
-  std::snprintf(out, sizeof out, "%.*f", decimals > 0 ? decimals : 0, v);
+  decimals = std::max(decimals, 0);
+  std::string out(std::size_t(std::snprintf(nullptr, 0, "%.*f", decimals, v)), '\0');
+  std::snprintf(out.data(), out.size() + 1, "%.*f", decimals, v);
   return out;
 }
 
@@ -37,7 +39,8 @@ double shortest_decimal(float f) {
 
 std::string duration_text(double s) {
   char out[48];
-  if (s == 0) return "0 s";
+  if (s == 0 || !std::isfinite(s)) return significant(s, 3) + " s";
+  if (s < 0) return duration_text(-s).insert(0, 1, '-');
   // Each unit up to where its three digits would round to 1000 (or to a minute).
   if (s < 59.95) {
     const auto [scale, unit] = s < 999.5e-9   ? std::pair{1e9, " ns"}
@@ -46,9 +49,15 @@ std::string duration_text(double s) {
                                               : std::pair{1.0, " s"};
     return significant(s * scale, 3) + unit;
   }
-  const long r = std::lround(s);
-  if (r < 3600) std::snprintf(out, sizeof out, "%ld min %02ld s", r / 60, r % 60);
-  else std::snprintf(out, sizeof out, "%ld h %02ld min", r / 3600, r % 3600 / 60);
+  if (s < 3599.5) {
+    const long r = std::lround(s);
+    std::snprintf(out, sizeof out, "%ld min %02ld s", r / 60, r % 60);
+  } else if (s < 3.6e15) {  // minutes a long holds
+    const long m = std::lround(s / 60);
+    std::snprintf(out, sizeof out, "%ld h %02ld min", m / 60, m % 60);
+  } else {
+    return significant(s / 3600, 3) + " h";
+  }
   return out;
 }
 

@@ -118,8 +118,12 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
 int first_stop_step(const Params& p) {
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   int step = std::max(p.min_steps, 1);
-  if (step * double(p.dt) < drag_end) step = int(std::ceil(drag_end / double(p.dt)));
-  while (step * double(p.dt) < drag_end) ++step;  // the quotient rounded down
+  if (step * double(p.dt) >= drag_end) return step;
+  // A path that ends past the last step an int can count: never.
+  const double q = std::ceil(drag_end / double(p.dt));
+  if (q >= double(std::numeric_limits<int>::max())) return std::numeric_limits<int>::max();
+  step = int(q);
+  while (step < std::numeric_limits<int>::max() && step * double(p.dt) < drag_end) ++step;  // q rounded down
   return step;
 }
 

@@ -289,11 +289,12 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     m.ny = integer(s[1], where + ".size[1]", 1);
     m.nz = want == 3 ? integer(s[2], where + ".size[2]", 1) : 1;
   }
-  // A layer gives the spacing or the width (spacing 0: width / (nx - 1)), and replaces the other.
+  // A layer gives the spacing or the width (spacing 0: width over the grid's first axis with more
+  // than one node), and replaces the other.
   if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);
   if (j.contains("width")) {
     if (m.spacing > 0 && j.contains("spacing"))
-      bad(where + ".width", "give spacing or width, not both (the width is (nx - 1) x spacing)");
+      bad(where + ".width", "give spacing or width, not both (each sets the other)");
     m.width = num(j["width"], where + ".width", Range::positive);
     m.spacing = 0;
   }
@@ -510,7 +511,7 @@ json to_json(const Scene& s) {
     if (ms.density > 0) model["density"] = ms.density;
   } else {
     model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"height", m.height}});
-    if (m.spacing > 0) model["spacing"] = m.spacing;  // the width it sets is (nx - 1) x spacing
+    if (m.spacing > 0) model["spacing"] = m.spacing;  // it sets the width
     else model["width"] = m.width;
     model["size"] = m.topology == Topology::lattice ? json::array({m.nx, m.ny, m.nz}) : json::array({m.nx, m.ny});
   }

@@ -50,8 +50,8 @@ struct MeshSpec {
 struct ModelSpec {
   Topology topology = Topology::cloth_grid;  // general: a mesh (read or generated)
   int nx = 128, ny = 128, nz = 1;
-  float spacing = 0.f;  // 0: derived from `width` (cloth: width / (nx - 1))
-  float width = 1.f;    // m, along x
+  float spacing = 0.f;  // 0: derived from `width` (width / (nx - 1); build_model_in_file_order)
+  float width = 1.f;    // m, along x (along the next axis with more than one node where nx = 1)
   float height = 1.f;   // m, y of the cloth plane / bottom of the lattice
   MeshSpec mesh;
   Material material;

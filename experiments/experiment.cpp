@@ -89,8 +89,10 @@ Experiment parse_experiment(const std::string& text, const std::string& where, c
 
 Experiment load_experiment(const std::string& path) {
   Experiment x = from_json(read_json_file(path, "experiment file"), path, std::filesystem::path(path).parent_path().string());
-  if (const std::string stem = std::filesystem::path(path).stem().string(); x.name.empty() && is_plain_name(stem))
+  if (const std::string stem = std::filesystem::path(path).stem().string(); x.name.empty() && is_plain_name(stem)) {
     x.name = stem;
+    x.raw["name"] = stem;  // as the manifests and reports record it
+  }
   return x;
 }
 

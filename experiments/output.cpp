@@ -66,14 +66,24 @@ bool reclaimable(const std::string& name) {
   return pid == ::getpid() || (::kill(pid, 0) == -1 && errno == ESRCH);
 }
 
-// Whether `dir` holds the staging folder of a process that is gone: one stopped in its commit
-// (or before it), whose outputs may have been moved in without their manifest.
-bool holds_stopped_staging(const fs::path& dir) {
+// A commit stopped between its renames (its process gone) left the folder without a manifest,
+// some of its outputs moved in and the rest, with its manifest, in its staging folder: this
+// moves those in, the manifest last, so that the folder holds that run's complete outputs.
+void finish_stopped_commit(const fs::path& dir) {
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (const std::string name = e.path().filename().string(); name.starts_with(".staging-") && reclaimable(name))
-      return true;
-  return false;
+  if (fs::exists(dir / "manifest.json", ec)) return;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.starts_with(".staging-") || !reclaimable(name) || folder_holds(e.path()) != Holds::run) continue;
+    for (const auto& f : fs::directory_iterator(e.path())) {
+      if (f.path().filename() == "manifest.json") continue;
+      const fs::path target = dir / f.path().filename();
+      fs::remove_all(target);
+      fs::rename(f.path(), target);
+    }
+    fs::rename(e.path() / "manifest.json", dir / "manifest.json");
+    return;
+  }
 }
 
 }  // namespace
@@ -106,28 +116,34 @@ void OutputDir::require_replaceable(const std::vector<std::string>& names) const
   }
 }
 
-void OutputDir::require_ours(const std::vector<std::string>& writes, bool commit_stopped) const {
+void OutputDir::require_ours(const std::vector<std::string>& writes) const {
   std::error_code ec;
-  const json old = held_output_ ? read_manifest(dir_) : json();
-  for (const auto& name : writes) {
-    if (commit_stopped || !fs::exists(fs::symlink_status(dir_ / entry_name(name), ec))) continue;
-    // A manifest without "files" predates the list: its folder's outputs are taken as its own.
-    if (held_output_ && (!old.contains("files") || old["files"].contains(name))) continue;
-    throw std::invalid_argument("output folder '" + dir_.string() + "' holds '" + name +
-                                "', which no earlier run's manifest there names (not a deformlab output): move it "
-                                "or give another --out");
-  }
+  for (const auto& name : writes)
+    if (fs::exists(fs::symlink_status(dir_ / entry_name(name), ec)) && !earlier_.count(name))
+      throw std::invalid_argument("output folder '" + dir_.string() + "' holds '" + name +
+                                  "', which no earlier run's manifest there names (not a deformlab output): move it "
+                                  "or give another --out");
 }
 
 OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes)
     : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
+  created_ = !fs::exists(dir_, ec);
+  if (!created_) finish_stopped_commit(dir_);
   require_replaceable(outputs_);
   require_replaceable({"manifest.json"});
-  created_ = !fs::exists(dir_, ec);
-  held_output_ = folder_holds(dir_) == Holds::run;
-  require_ours(writes, holds_stopped_staging(dir_));
+  // The earlier run's outputs, by its manifest ("files"; one without the list predates it and
+  // takes them all, and one from before "frames/" was listed names its frames as "frames").
+  if (const json old = read_manifest(dir_); folder_holds(dir_) == Holds::run) {
+    for (const auto& name : outputs_)
+      if (!old.contains("files") || old["files"].contains(name) || (name == "frames/" && old.contains("frames")))
+        earlier_.insert(name);
+  } else if (fs::exists(fs::symlink_status(dir_ / "manifest.json", ec))) {
+    throw std::invalid_argument("output folder '" + dir_.string() +
+                                "' holds a manifest.json that is no deformlab run's: move it or give another --out");
+  }
+  require_ours(writes);
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
   reclaim_temporaries(dir_);
@@ -155,8 +171,8 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
     throw std::runtime_error(std::string(e.what()) + "; this run's outputs are in '" + kept.string() + "'");
   }
   fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
-  for (const auto& name : outputs_)
-    if (held_output_ && !fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
+  for (const auto& name : earlier_)
+    if (!fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
   for (const auto& e : fs::directory_iterator(staging_)) {
     if (e.path().filename() == "manifest.json") continue;
     const fs::path target = dir_ / e.path().filename();

@@ -5,6 +5,7 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -37,15 +38,15 @@ void reclaim_temporaries(const std::filesystem::path& dir);
 
 class OutputDir {
  public:
-  // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder, or
-  // holds a file where an output has a folder or the other way round).
+  // Creates `dir` if needed (throws std::invalid_argument if it is not a usable folder, holds
+  // a file where an output has a folder or the other way round, or a manifest.json that is no
+  // run's). A commit that was stopped in `dir` is finished first.
   // `outputs`: every name such an output may hold besides manifest.json, a folder's ending in
-  // '/'; where the folder held one (its manifest says so), commit() removes those the new one
-  // does not write, so that the folder holds one output's files. Files in a folder that held
-  // none are left alone. `writes`: those of `outputs` this output will write; each that is in
-  // the folder already must be the earlier output's (its manifest's "files" names it) or left
-  // by a commit that was stopped (a stopped process's staging folder is there), else it is
-  // someone else's and std::invalid_argument is thrown rather than replace it.
+  // '/'; those the folder's earlier run wrote (its manifest's "files") and the new one does not
+  // write, commit() removes, so that the folder holds one output's files; all else is left
+  // alone. `writes`: those of `outputs` this output will write; each that is in the folder
+  // already must be the earlier run's, else it is someone else's and std::invalid_argument is
+  // thrown rather than replace it.
   OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes);
   // Removes the staging folder, and the output folder too if this object created it and
   // nothing was committed.
@@ -68,10 +69,10 @@ class OutputDir {
   // Throws std::invalid_argument where one of `names` (a folder's ending in '/') is in the
   // output folder as the other kind of entry.
   void require_replaceable(const std::vector<std::string>& names) const;
-  void require_ours(const std::vector<std::string>& writes, bool commit_stopped) const;
+  void require_ours(const std::vector<std::string>& writes) const;
   std::filesystem::path dir_, staging_;
   std::vector<std::string> outputs_;
-  bool held_output_ = false;  // the folder held such an output when this object was made
+  std::set<std::string> earlier_;  // of `outputs_`, those the folder's earlier run wrote
   bool created_ = false;
 };
 

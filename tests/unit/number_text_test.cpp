@@ -20,6 +20,8 @@ TEST(NumberText, SignificantDigitsNeverUseAnExponent) {
   EXPECT_EQ(significant(9.9996, 4), "10.00");
   EXPECT_EQ(significant(0.099996, 3), "0.100");
   EXPECT_EQ(significant(std::numeric_limits<double>::quiet_NaN(), 3), "nan");
+  EXPECT_EQ(significant(1e300, 3).size(), 301u) << "every digit of a large number";
+  EXPECT_EQ(significant(1e-300, 2).substr(0, 4), "0.00");
   // Trimmed, as %g would write them but never with an exponent.
   EXPECT_EQ(significant_trimmed(0.5, 3), "0.5");
   EXPECT_EQ(significant_trimmed(4.3e-05, 3), "0.000043");
@@ -47,6 +49,11 @@ TEST(NumberText, DurationsTakeTheUnitThatSuitsThem) {
   EXPECT_EQ(duration_text(59.97), "1 min 00 s");
   EXPECT_EQ(duration_text(123), "2 min 03 s");
   EXPECT_EQ(duration_text(3725), "1 h 02 min");
+  EXPECT_EQ(duration_text(3599.7), "1 h 00 min");
+  EXPECT_EQ(duration_text(7199), "2 h 00 min") << "minutes rounded, as seconds are";
+  EXPECT_EQ(duration_text(-0.25), "-250 ms");
+  EXPECT_EQ(duration_text(std::numeric_limits<double>::infinity()), "inf s");
+  EXPECT_EQ(duration_text(3.6e18), "1000000000000000 h");
 }
 
 TEST(NumberText, CountsTakeTheirNounsNumber) {

@@ -39,7 +39,8 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
   const fs::path dir = fresh("deformlab-commit-in-the-way");
   fs::create_directories(dir / "state.ply");  // a folder where the output writes a file
   write(dir / "state.ply" / "x", "in the way");
-  write(dir / "manifest.json", "old");
+  const std::string old = R"({"experiment": "paper-drag", "files": {}})";  // a run's, that wrote none of them
+  write(dir / "manifest.json", old);
   const std::string error = "output folder '" + dir.string() +
                             "' holds a folder named 'state.ply' where this output writes a file: move it or give another --out";
   try {
@@ -67,7 +68,7 @@ TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
     }
     EXPECT_EQ(read(kept / "state.ply"), "new") << "the run's outputs kept";
   }
-  EXPECT_EQ(read(dir / "manifest.json"), "old") << "the folder as it was";
+  EXPECT_EQ(read(dir / "manifest.json"), old) << "the folder as it was";
   EXPECT_FALSE(fs::exists(dir / "summary.txt"));
   fs::remove_all(dir);
 }
@@ -80,7 +81,8 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   EXPECT_EXIT(
       {
         OutputDir out(dir, kOutputs, kWrites);
-        for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "new");
+        for (const char* f : {"summary.txt", "state.ply"}) write(out.staged(f), "new");
+        write(out.staged("manifest.json"), R"({"experiment": "new"})");
         out.commit([](const fs::path&) { ::_exit(3); });
       },
       testing::ExitedWithCode(3), "");
@@ -91,7 +93,9 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   EXPECT_EQ(moved, 1) << "one output moved in before the stop";
   EXPECT_EQ(staging, 1) << "the stopped process's staging folder";
   {
-    OutputDir out(dir, kOutputs, kWrites);
+    OutputDir out(dir, kOutputs, kWrites);  // finishes the stopped commit first
+    EXPECT_EQ(read(dir / "manifest.json"), R"({"experiment": "new"})");
+    for (const char* f : {"summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "new") << f;
     for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) write(out.staged(f), "newer");
     out.commit();
   }
@@ -162,6 +166,21 @@ TEST(OutputDir, WhatNoRunWroteIsNotReplaced) {
     out.commit();
   }
   EXPECT_FALSE(fs::exists(dir / "frames" / "keep.txt"));
+  // A manifest from before "frames/" was listed names the frames as "frames".
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": ""}, "frames": {}})");
+  EXPECT_NO_THROW(OutputDir(dir, kOutputs, with_frames));
+  // What the earlier run did not write stays, though the new one does not write it either.
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": ""}})");
+  write(dir / "trace.json", "mine");
+  {
+    OutputDir out(dir, kOutputs, {"summary.txt"});
+    write(out.staged("manifest.json"), "new");
+    out.commit();
+  }
+  EXPECT_EQ(read(dir / "trace.json"), "mine");
+  // A manifest.json that is no run's is not replaced either.
+  write(dir / "manifest.json", R"({"name": "my web app"})");
+  EXPECT_THROW(OutputDir(dir, kOutputs, {"summary.txt"}), std::invalid_argument);
   fs::remove_all(dir);
 }
 

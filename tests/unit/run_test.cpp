@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -28,6 +29,24 @@ TEST(Run, StabilityLimitIsTheGershgorinBound) {
   Params p;
   p.drag = {40, {{0.f, {}}}, true, 1e5f};
   EXPECT_NEAR(stability_limit(m, p, semi), 2 * std::sqrt(0.01 / (k_eff + 1e5)), 1e-12);
+}
+
+// The stop rule starts at min_steps, or at the first step at or past the drag path's end; a
+// path too long for an int's steps never lets it start (and takes no time to say so).
+TEST(Run, FirstStopStepIsMinStepsOrThePathsEnd) {
+  Params p;
+  p.dt = 0.002f;
+  p.min_steps = 100;
+  EXPECT_EQ(first_stop_step(p), 100) << "no drag";
+  p.drag = {0, {{0.f, {}}, {2.f, {}}}, false, 1.f};
+  EXPECT_EQ(first_stop_step(p), 1000) << "step 1000 is at t = 2.0000001 s (dt as a float)";
+  EXPECT_GE(1000 * double(p.dt), 2.0);
+  EXPECT_LT(999 * double(p.dt), 2.0);
+  p.min_steps = 5000;
+  EXPECT_EQ(first_stop_step(p), 5000);
+  p.min_steps = 0;
+  p.dt = 1e-10f;
+  EXPECT_EQ(first_stop_step(p), std::numeric_limits<int>::max());
 }
 
 // Two free nodes on one spring: w^2 = 2k/m exactly, which is also the Gershgorin bound. Each

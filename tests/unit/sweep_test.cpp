@@ -210,6 +210,14 @@ TEST_F(SweepTest, AFileWithoutANameIsNamedByItsFile) {
   fs::create_directories(dir_);
   std::ofstream(dir_ / "my-drag.json") << R"({"base": "paper-drag"})";
   EXPECT_EQ(load_experiment_by_name((dir_ / "my-drag.json").string()).name, "my-drag");
+  // Its sweep's results record that name, so another experiment is refused their folder.
+  std::ofstream(dir_ / "my-sweep.json")
+      << R"({"base": "paper-drag", "sweep": {"sizes": [4], "pipelines": ["cpu"], "repetitions": 1, "frames": 0}})";
+  const Experiment x = load_experiment_by_name((dir_ / "my-sweep.json").string());
+  run_sweep(x, *parse_sweep(x.raw, "my-sweep"), dir_ / "out", {}, json::array());
+  EXPECT_EQ(json::parse(slurp(dir_ / "out" / "manifest.json"))["experiment"]["name"], "my-sweep");
+  EXPECT_EQ(slurp(write_report(dir_ / "out")).rfind("# my-sweep\n", 0), 0u);
+  EXPECT_THROW(require_same_experiment(dir_ / "out", "my-drag"), std::invalid_argument);
   std::ofstream(dir_ / "named.json") << R"({"name": "other", "base": "paper-drag"})";
   EXPECT_EQ(load_experiment_by_name((dir_ / "named.json").string()).name, "other");
 }
