@@ -1,6 +1,5 @@
 #include <iomanip>
 #include <iostream>
-#include <map>
 
 #include "commands.hpp"
 #include "core/integrator.hpp"
@@ -8,21 +7,6 @@
 #include "experiments/pipelines.hpp"
 
 namespace deformlab::app {
-
-namespace {
-
-// What each option takes, as `run --option NAME=VALUE` reads it (README: Using it).
-std::string option_values(const std::string& name) {
-  static const std::map<std::string, std::string> values = {
-      {"tile", "WxH"},     {"tma", "on|off"},    {"math", "exact|fast"},
-      {"window", "N"},     {"link_view", "N"},   {"steps_per_launch", "1-8"},
-      {"memory", "gl|cuda"}, {"force", "naive|tiled|scatter"},
-      {"interop", "map|external|external-gpusync|staged"}};
-  const auto v = values.find(name);
-  return v == values.end() ? "VALUE" : v->second;
-}
-
-}  // namespace
 
 int list_command() {
   std::cout << "Pipelines (in order of expected speed; 'best' picks the first available, passing over GL on a "

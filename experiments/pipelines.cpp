@@ -1,5 +1,6 @@
 #include "pipelines.hpp"
 
+#include <map>
 #include <stdexcept>
 
 #include "core/cpu_backend.hpp"
@@ -115,6 +116,16 @@ std::string gpu_bus_id(const PipelineEntry& e) {
   if (e.traits.force == Engine::cuda) return cuda::device_info().pci_bus_id;
 #endif
   return {};
+}
+
+std::string option_values(const std::string& name) {
+  static const std::map<std::string, std::string> values = {
+      {"tile", "WxH"},     {"tma", "on|off"},    {"math", "exact|fast"},
+      {"window", "N"},     {"link_view", "N"},   {"steps_per_launch", "1-8"},
+      {"memory", "gl|cuda"}, {"force", "naive|tiled|scatter"},
+      {"interop", "map|external|external-gpusync|staged"}};
+  const auto v = values.find(name);
+  return v == values.end() ? "VALUE" : v->second;
 }
 
 bool on_software_gl(const PipelineEntry& e) {

@@ -2,6 +2,8 @@
 // build, whether its backend is built or stands in as unavailable; the untimed warm-up.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <chrono>
 #include <fstream>
 #include <numeric>
@@ -162,6 +164,16 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
   for (const char* name : {"cuda-temporal", "glsl-compute"}) {
     if (r.find(name)->read_options) {
       EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
+    }
+  }
+  // Every value of a choice that `deformlab list` shows is one its pipelines read.
+  for (const auto& e : r.all()) {
+    if (!e.read_options) continue;
+    for (const auto& name : e.options) {
+      const std::string values = option_values(name);
+      if (values.find('|') == std::string::npos) continue;  // a form: "WxH", "N"
+      std::stringstream choices(values);
+      for (std::string v; std::getline(choices, v, '|');) EXPECT_EQ(refusal(e.name.c_str(), {{name, v}}), "") << e.name;
     }
   }
 }
