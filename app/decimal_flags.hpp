@@ -10,20 +10,22 @@
 
 namespace deformlab::app {
 
-// Whether `v` is a decimal number (whole: digits only) in full, with one optional sign; from_chars
-// reads no other base unless asked, and "inf" and "nan" only as reals.
-inline bool is_decimal(const std::string& v, bool whole) {
+// What is wrong with `v` as a decimal number (whole: digits only, and an int), or "": one
+// optional sign, all of it read by from_chars, which reads no other base unless asked, and
+// "inf" and "nan" only as reals.
+inline std::string decimal_problem(const std::string& v, bool whole) {
   const char* at = v.data() + (v.starts_with('+') ? 1 : 0);
   const char* end = v.data() + v.size();
-  if (at == end || (at != v.data() && *at == '-')) return false;
-  if (whole) {
-    long long n = 0;
-    const auto r = std::from_chars(at, end, n);
-    return r.ptr == end && (r.ec == std::errc() || r.ec == std::errc::result_out_of_range);
-  }
+  long long n = 0;
   double d = 0;
-  const auto r = std::from_chars(at, end, d);
-  return r.ptr == end && (r.ec == std::errc() || r.ec == std::errc::result_out_of_range);
+  std::from_chars_result r{at, std::errc::invalid_argument};
+  if (at != end && !(at != v.data() && *at == '-')) r = whole ? std::from_chars(at, end, n) : std::from_chars(at, end, d);
+  if (r.ptr != end || r.ec == std::errc::invalid_argument)
+    return "'" + v + "' is not " + (whole ? "a whole decimal number" : "a decimal number");
+  if (whole && (r.ec != std::errc() || n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max()))
+    return "'" + v + "' is out of range (" + std::to_string(std::numeric_limits<int>::min()) + " to " +
+           std::to_string(std::numeric_limits<int>::max()) + ")";  // every whole-number flag is an int
+  return "";
 }
 
 // Checks every whole-number and real option of `app`'s subcommands (and their vectors' items).
@@ -31,22 +33,9 @@ inline void decimal_numbers_only(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands({}))
     for (CLI::Option* opt : sub->get_options()) {
       const std::string type = opt->get_type_name();  // "INT", or "INT:" and a check's description
-      const bool is_int = type.starts_with("INT") || type.starts_with("UINT");
-      if (!is_int && !type.starts_with("FLOAT")) continue;
-      opt->check(CLI::Validator(
-          [is_int](std::string& v) -> std::string {
-            if (!is_decimal(v, is_int))
-              return "'" + v + "' is not " + (is_int ? "a whole decimal number" : "a decimal number");
-            if (!is_int) return "";
-            // Every whole-number flag is an int.
-            long long n = 0;
-            const auto [end, err] = std::from_chars(v.data() + (v[0] == '+'), v.data() + v.size(), n);
-            if (err == std::errc() && n >= std::numeric_limits<int>::min() && n <= std::numeric_limits<int>::max())
-              return "";
-            return "'" + v + "' is out of range (" + std::to_string(std::numeric_limits<int>::min()) + " to " +
-                   std::to_string(std::numeric_limits<int>::max()) + ")";
-          },
-          ""));
+      const bool whole = type.starts_with("INT") || type.starts_with("UINT");
+      if (whole || type.starts_with("FLOAT"))
+        opt->check(CLI::Validator([whole](std::string& v) { return decimal_problem(v, whole); }, ""));
     }
 }
 

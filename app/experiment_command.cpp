@@ -70,7 +70,6 @@ int experiment_command(const ExperimentArgs& a) {
       o.max_size = a.max_size;
       o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
-        const double left = ran > 0 ? p.elapsed_s / ran * (p.total - p.done) : 0.0;
         std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
@@ -80,7 +79,8 @@ int experiment_command(const ExperimentArgs& a) {
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
         std::cout << "  [" << duration_text(p.elapsed_s);
         // The time left at the rate of the cells run so far: none to go by while only kept cells came.
-        if (p.done < p.total && ran > 0) std::cout << ", about " << duration_text(left) << " left";
+        if (p.done < p.total && ran > 0)
+          std::cout << ", about " << duration_text(p.elapsed_s / ran * (p.total - p.done)) << " left";
         std::cout << "]" << std::endl;
       };
       nlohmann::json command = a.argv;

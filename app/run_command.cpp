@@ -1,7 +1,6 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -152,7 +151,7 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"setup", {{"model_build_s", in.build_s}, {"pipeline_setup_s", setup_s}, {"clock", "host steady_clock"}}},
       {"warm_up", {{"steps", ran.warm_up.steps}, {"ms", ran.warm_up.ms}, {"clock", "host steady_clock"},
                    {"what", "untimed steps from rest before the run, which then starts from rest"}}},
-      {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", std::round(r.steps * shortest_decimal(in.params.dt) * 1e9) / 1e9},
+      {"result", {{"steps", r.steps}, {"converged", r.converged}, {"simulated_time_s", simulated_time_s(r.steps, in.params.dt)},
                   {"last_max_displacement_m", r.last_displacement}, {"total_ms", r.total_ms},
                   {"wall_ms", r.wall_ms}, {"wall_clock", "host steady_clock from the first step to the device's end "
                                                          "of the last, checks and frames included"},
@@ -191,7 +190,7 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   for (const auto& [name, value] : pipe.chosen_options())
     std::cout << "  option " << name << "=" << value << ": chosen for this machine (none given)\n";
   for (const auto& line : m.repairs) std::cout << "  mesh: " << line << "\n";
-  std::cout << "  steps: " << r.steps << " (" << significant_trimmed(r.steps * shortest_decimal(in.params.dt), 6)
+  std::cout << "  steps: " << r.steps << " (" << significant_trimmed(simulated_time_s(r.steps, in.params.dt), 6)
             << " s simulated); ";
   if (r.converged)
     std::cout << "converged: no node moved more than " << significant_trimmed(in.params.threshold, 3)

@@ -115,6 +115,8 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   return os.str();
 }
 
+double simulated_time_s(int steps, float dt) { return std::round(steps * shortest_decimal(dt) * 1e9) / 1e9; }
+
 int first_stop_step(const Params& p) {
   const double drag_end = p.drag.active() ? p.drag.end_time() : 0.0;
   int step = std::max(p.min_steps, 1);
@@ -162,7 +164,7 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     times.end();
     const double queue_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     r.steps = step;
-    r.records.push_back({step, step * shortest_decimal(p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
+    r.records.push_back({step, simulated_time_s(step, p.dt), std::numeric_limits<double>::quiet_NaN(), queue_ms,
                          std::numeric_limits<double>::quiet_NaN()});
     if (queued && step == queued + launch) {  // the check before this launch, read while it runs
       const int checked = std::exchange(queued, 0);

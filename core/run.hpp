@@ -56,6 +56,10 @@ struct RunResult {
   std::vector<StepRecord> records;
 };
 
+// The simulated time after `steps` steps of `dt`, in the decimals the scene gave dt in (0.002 s
+// a step, not the float's 0.0020000000949949026) to the nanosecond.
+double simulated_time_s(int steps, float dt);
+
 // The first step at which the stop rule may end a convergence run: from min_steps on, once
 // the drag path has ended.
 int first_stop_step(const Params& p);

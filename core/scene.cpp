@@ -414,15 +414,16 @@ Scene load_scene(const std::string& path) {
 Params resolve_params(const Scene& s, const Model& m) {
   Params p = s.params;
   if (s.drag.enabled) {
+    const std::string where = s.drag.node.where.empty() ? "drag node" : s.drag.node.where;
     int node = -1;
     try {
       node = select_nodes(m, s.drag.node).at(0);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument((s.drag.node.where.empty() ? "drag node" : s.drag.node.where) + ": " + e.what());
+      throw std::invalid_argument(where + ": " + e.what());
     }
     if (m.pinned(node))
-      throw std::invalid_argument((s.drag.node.where.empty() ? "drag node" : s.drag.node.where) + ": node " +
-                                  std::to_string(node) + " is pinned (model.pins), so the drag would not move it");
+      throw std::invalid_argument(where + ": node " + std::to_string(node) +
+                                  " is pinned (model.pins), so the drag would not move it");
     p.drag.node = node;
     if (s.drag.offsets)
       for (auto& k : p.drag.path) k.position = m.rest_position[node] + k.position;
