@@ -16,7 +16,7 @@ class StepTimer {
   virtual void end() = 0;    // just after it
   // ms of each step ended since the last call, in order; waits for the device to finish them.
   virtual std::vector<double> take() = 0;
-  // The clock, as a user reads it ("CUDA events", "GL timer queries (GL_TIMESTAMP)", "host clock").
+  // The clock, as a user reads it ("CUDA events", "GL timer queries", "host clock").
   virtual std::string clock() const = 0;
 };
 

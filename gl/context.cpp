@@ -366,7 +366,7 @@ std::vector<double> Timer::take() {
 
 std::string Timer::method() const {
   return software_ ? "host clock after glFinish, as software OpenGL's timer queries mean nothing"
-                   : "GL timer queries (GL_TIMESTAMP)";
+                   : "GL timer queries";
 }
 
 void TimerSpans::begin(const Profiler& p, const char* name) {
