@@ -18,7 +18,7 @@ int list_command() {
               << (on_software_gl(e) ? " [software GL: slower than the CPU pipelines here]" : "") << "\n";
     if (!e.options.empty()) {
       std::cout << "  " << std::setw(15) << "" << "  options:";
-      for (const auto& o : e.options) std::cout << " " << o << "=" << option_values(o);
+      for (const auto& o : e.options) std::cout << " " << o << "=" << option_values(e, o);
       std::cout << "\n";
     }
     if (!why.empty()) {

@@ -118,7 +118,8 @@ std::string gpu_bus_id(const PipelineEntry& e) {
   return {};
 }
 
-std::string option_values(const std::string& name) {
+std::string option_values(const PipelineEntry& e, const std::string& name) {
+  if (name == "tile" && e.name == "cuda-temporal") return "WxH or WxHxD";  // WxHxD on lattices
   static const std::map<std::string, std::string> values = {
       {"tile", "WxH"},     {"tma", "on|off"},    {"math", "exact|fast"},
       {"window", "N"},     {"link_view", "N"},   {"steps_per_launch", "1-8"},

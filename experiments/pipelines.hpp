@@ -16,9 +16,10 @@ std::string gpu_bus_id(const PipelineEntry& e);
 // Whether `e` runs its passes on a software GL rasteriser (llvmpipe): slower than the CPU
 // pipelines, so `best` passes it over.
 bool on_software_gl(const PipelineEntry& e);
-// What option `name` takes, for `deformlab list`: the values of a choice ("exact|fast"), which
-// the pipelines that read it accept (tested), or the form of a value ("WxH", "N", "1-8").
-std::string option_values(const std::string& name);
+// What option `name` of pipeline `e` takes, for `deformlab list`: the values of a choice
+// ("exact|fast"), which the pipelines that read it accept (tested), or the form of a value
+// ("WxH", "N", "1-8").
+std::string option_values(const PipelineEntry& e, const std::string& name);
 // The first pipeline in order of expected speed that is available here, runs `i` and does not
 // run on a software rasteriser.
 const PipelineEntry& best_pipeline(Integrator i);

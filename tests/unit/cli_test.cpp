@@ -253,6 +253,7 @@ TEST_F(Cli, ListShowsEveryPipelineAndIntegrator) {
     EXPECT_NE(r.out.find(name), std::string::npos) << name;
   // Each pipeline's options with the values they take, every option's values known.
   EXPECT_NE(r.out.find("options: tile=WxH tma=on|off math=exact|fast\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("options: tile=WxH or WxHxD steps_per_launch=1-8 math=exact|fast\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("options: interop=map|external|external-gpusync|staged force=naive|tiled|scatter"),
             std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("=VALUE"), std::string::npos) << r.out;

@@ -2,8 +2,8 @@
 // build, whether its backend is built or stands in as unavailable; the untimed warm-up.
 #include <gtest/gtest.h>
 
-#include <sstream>
-
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <fstream>
 #include <numeric>
@@ -166,14 +166,24 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
       EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
     }
   }
-  // Every value of a choice that `deformlab list` shows is one its pipelines read.
+  // Every value of a choice that `deformlab list` shows, and an instance of every form it shows
+  // ("WxH or WxHxD", "N", "1-8": each letter a 4, a range's ends), is one its pipelines read.
   for (const auto& e : r.all()) {
     if (!e.read_options) continue;
     for (const auto& name : e.options) {
-      const std::string values = option_values(name);
-      if (values.find('|') == std::string::npos) continue;  // a form: "WxH", "N"
-      std::stringstream choices(values);
-      for (std::string v; std::getline(choices, v, '|');) EXPECT_EQ(refusal(e.name.c_str(), {{name, v}}), "") << e.name;
+      const std::string values = option_values(e, name) + "|";
+      const bool range = std::isdigit(static_cast<unsigned char>(values[0]));
+      std::string v;
+      for (std::size_t at = 0; at < values.size(); ++at) {
+        const bool or_word = values.compare(at, 4, " or ") == 0;
+        if (values[at] == '|' || or_word || (range && values[at] == '-')) {
+          EXPECT_EQ(refusal(e.name.c_str(), {{name, v}}), "") << e.name << " " << name << "=" << v;
+          v.clear();
+          at += or_word ? 3 : 0;
+        } else {
+          v += std::string("WHDN").find(values[at]) != std::string::npos ? '4' : values[at];
+        }
+      }
     }
   }
 }
