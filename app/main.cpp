@@ -4,7 +4,7 @@
 
 #include "commands.hpp"
 #include "core/one_line.hpp"
-#include "decimal_flags.hpp"
+#include "command_line.hpp"
 #include "experiments/experiment.hpp"
 
 namespace deformlab::app {
@@ -107,12 +107,10 @@ int main(int argc, char** argv) {
   mesh->add_option("--out,-o", mesh_args.out, "The .msh file to write")->required();
 
   deformlab::app::decimal_numbers_only(cli);
-  // A parse error points to the help of the command it was in.
-  std::string help = "deformlab --help";
   if (argc > 1 && argv[1][0] != '-') {
     const std::string command = argv[1];
-    bool known = false;
     std::string names;
+    bool known = false;
     for (const CLI::App* sub : cli.get_subcommands({})) {
       known = known || sub->get_name() == command;
       names += (names.empty() ? "" : ", ") + sub->get_name();
@@ -125,18 +123,8 @@ int main(int argc, char** argv) {
       std::cerr << "deformlab: error: unknown command '" << command << "' (valid: " << names << ")\n";
       return 2;
     }
-    help = "deformlab " + command + " --help";
   }
-  try {
-    cli.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return cli.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return cli.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "deformlab: error: " << deformlab::one_line(e.what()) << " (see " << help << ")\n";
-    return 2;
-  }
+  if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   if (*run) return deformlab::app::run_command(a);
   if (*experiment) return deformlab::app::experiment_command(ex);
   if (*list) return deformlab::app::list_command();

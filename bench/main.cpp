@@ -1,12 +1,12 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "app/decimal_flags.hpp"
+#include "app/command_line.hpp"
 #include "bench.hpp"
 #include "core/one_line.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App cli{"deformlab-bench: timings of deformlab's pipelines (not tests)"};
+  CLI::App cli{"deformlab-bench: timings of deformlab's pipelines (not tests)", "deformlab-bench"};
   cli.require_subcommand(1);
   cli.option_defaults()->always_capture_default();  // --help shows each option's default
   deformlab::bench::add_cpu_bench(cli);
@@ -22,9 +22,7 @@ int main(int argc, char** argv) {
 #endif
   deformlab::app::decimal_numbers_only(cli);
   try {
-    cli.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return cli.exit(e) == 0 ? 0 : 2;
+    if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   } catch (const std::invalid_argument& e) {  // bad input
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 2;

@@ -66,6 +66,7 @@ const std::vector<BadInput>& cases() {
       {"steps_negative", "run --steps -5", "--steps"},
       {"steps_letters", "run --steps abc", "--steps"},
       {"dt_hexadecimal", "run --dt 0x10", "--dt: '0x10' is not a decimal number"},
+      {"grid_twice", "run --grid 8x8 --grid 9x9", "--grid is given 2 times; it takes one value (see deformlab run --help)"},
       {"unknown_command", "runn --grid 4x4", "unknown command 'runn' (valid: run, experiment, list, view, calibrate, mesh)"},
       {"steps_past_int", "run --steps 99999999999",
        "--steps: '99999999999' is out of range (-2147483648 to 2147483647) (see deformlab run --help)"},

@@ -1,12 +1,16 @@
-// CLI11 reads "0x10" as 16 (and "0b11" into some types): a number on a command line (deformlab's,
-// deformlab-bench's) is taken only as a decimal, so that a typo is refused rather than read in
-// another base. The words nan and inf pass to the options' own range checks, which name what
-// the option takes.
+// What deformlab's and deformlab-bench's command lines take and say beyond CLI11's defaults.
+//
+// CLI11 reads "0x10" as 16 (and "0b11" into some types): a number on a command line is taken
+// only as a decimal, so that a typo is refused rather than read in another base. The words nan
+// and inf pass to the options' own range checks, which name what the option takes.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <iostream>
 #include <charconv>
 #include <limits>
 #include <string>
+
+#include "core/one_line.hpp"
 
 namespace deformlab::app {
 
@@ -37,6 +41,27 @@ inline void decimal_numbers_only(CLI::App& app) {
       if (whole || type.starts_with("FLOAT"))
         opt->check(CLI::Validator([whole](std::string& v) { return decimal_problem(v, whole); }, ""));
     }
+}
+
+// Parses `argv` into `cli`: help is printed (0); a parse error is one line on stderr that
+// names the help of the command it was in, "program command --help" (2). Else -1.
+inline int parse_command_line(CLI::App& cli, int argc, char** argv) {
+  try {
+    cli.parse(argc, argv);
+    return -1;
+  } catch (const CLI::Success& e) {  // --help
+    return cli.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string what = one_line(e.what());
+    const std::string many = ": At Most 1 required but received ";  // CLI11's words for a repeated option
+    if (const auto at = what.find(many); at != std::string::npos)
+      what = what.substr(0, at) + " is given " + what.substr(at + many.size()) + " times; it takes one value";
+    std::string help = cli.get_name();
+    for (const CLI::App* sub : cli.get_subcommands({}))
+      if (argc > 1 && sub->get_name() == argv[1]) help += " " + sub->get_name();
+    std::cerr << cli.get_name() << ": error: " << what << " (see " << help << " --help)\n";
+    return 2;
+  }
 }
 
 }  // namespace deformlab::app
