@@ -2,9 +2,9 @@
 #pragma once
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/cpu_backend.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
@@ -20,24 +20,6 @@ namespace deformlab::test {
 
 // The same springs, seen as a general model: the kernels then gather over the CSR adjacency.
 inline Model as_general(const Model& m) { return explicit_springs(m); }
-
-
-inline double max_abs_position(const State& s) {
-  double m = 0;
-  for (const auto& x : s.x) m = std::max({m, double(std::abs(x.x)), double(std::abs(x.y)), double(std::abs(x.z))});
-  return m;
-}
-
-// A rounding floor for comparing two float runs: 4 ulps of the largest coordinate for
-// positions; for velocities, the same turned into a velocity by 1/dt (Verlet's v is a
-// position difference over dt).
-struct Tolerance {
-  double x = 0, v = 0;
-};
-inline Tolerance rounding_floor(const State& s, float dt) {
-  const double ulp = std::ldexp(1.0, std::ilogb(std::max(max_abs_position(s), 1e-3)) - 23);
-  return {4 * ulp, 4 * ulp / dt};
-}
 
 // Model m (damped, its top corners pinned) with a ground just under it at 1 m, two spheres
 // cutting it from below and a free node dragged along a path that ends after 10 ms, hard or

@@ -1,6 +1,7 @@
 #include "test_states.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -97,12 +98,51 @@ Params moving_params(const Model& m, Integrator i) {
 double max_diff(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
   if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
   double d = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, double(norm(a[i] - b[i])));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double e = norm(a[i] - b[i]);
+    if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();  // a NaN or inf on either side
+    d = std::max(d, e);
+  }
   return d;
 }
 
 double max_position_diff(const State& a, const State& b) { return max_diff(a.x, b.x); }
 double max_velocity_diff(const State& a, const State& b) { return max_diff(a.v, b.v); }
+
+namespace {
+// Root mean square of |a[i] - b[i]| over nodes (infinite as max_diff is).
+double rms_diff(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+  if (a.size() != b.size() || !std::isfinite(max_diff(a, b))) return std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double e = norm(a[i] - b[i]);
+    sum += e * e;
+  }
+  return a.empty() ? 0.0 : std::sqrt(sum / double(a.size()));
+}
+}  // namespace
+
+RoundingBound rounding_bound(const State& a, const State& r, Bound floor, double times) {
+  return {{std::max(times * max_diff(a.x, r.x), floor.x), std::max(times * max_diff(a.v, r.v), floor.v)},
+          {std::max(times * rms_diff(a.x, r.x), floor.x), std::max(times * rms_diff(a.v, r.v), floor.v)}};
+}
+
+Bound ulp_floor(const State& s, float dt) {
+  double largest = 1e-3;
+  for (const auto& x : s.x) largest = std::max({largest, double(std::abs(x.x)), double(std::abs(x.y)), double(std::abs(x.z))});
+  const double ulp = std::ldexp(1.0, std::ilogb(largest) - 23);
+  return {4 * ulp, 4 * ulp / dt};
+}
+
+testing::AssertionResult within_rounding(const State& g, const State& a, const RoundingBound& b) {
+  const double dx = max_diff(g.x, a.x), dv = max_diff(g.v, a.v), rx = rms_diff(g.x, a.x), rv = rms_diff(g.v, a.v);
+  const double dp = max_diff(g.x_prev, a.x_prev);
+  const bool ok = dx <= b.max.x && dv <= b.max.v && rx <= b.rms.x && rv <= b.rms.v && dp <= b.max.x;
+  auto result = ok ? testing::AssertionSuccess() : testing::AssertionFailure();
+  return result << "positions apart by " << dx << " m at most (bound " << b.max.x << "), " << rx << " rms (" << b.rms.x
+                << "); velocities " << dv << " m/s (" << b.max.v << "), " << rv << " rms (" << b.rms.v
+                << "); previous positions " << dp << " m" << (bitwise_equal(g, a) ? "; bitwise equal" : "");
+}
 
 bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)) == 0);

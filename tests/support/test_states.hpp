@@ -1,5 +1,7 @@
 // Shared helpers for tests that compare pipelines: small scenes and non-trivial states.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <vector>
 
@@ -36,10 +38,33 @@ Params moving_params(const Model& m, Integrator i);
 // (m) and velocities up to `vel_amp` (m/s), from a fixed seed (deterministic).
 State perturbed_state(const Model& m, std::uint32_t seed, float pos_amp = 0.01f, float vel_amp = 0.2f);
 
-// Largest |a[i] - b[i]| over nodes (infinite when the sizes differ); of positions, of velocities.
+// Largest |a[i] - b[i]| over nodes (infinite when the sizes differ or either holds a NaN or
+// an infinity); of positions, of velocities.
 double max_diff(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
 double max_position_diff(const State& a, const State& b);
 double max_velocity_diff(const State& a, const State& b);
+// How far a float pipeline that rounds otherwise than `cpu` (fast math, atomic sums, another
+// order of the same operations) may end from `cpu`'s state: `times` x the distance that float
+// rounding itself puts between `cpu`'s state and the double reference's on this very
+// trajectory, but at least a floor of a few ulp. Both the largest node distance and the root
+// mean square over nodes are bounded: on scenes with contact, float and double can put a node
+// on either side of a collider, which sets the largest distance; the root mean square still
+// sees a fault that moves many nodes a little (a stale buffer, a missing term).
+struct Bound {
+  double x = 0, v = 0;  // m, m/s
+};
+struct RoundingBound {
+  Bound max, rms;
+};
+// The bound from `cpu`'s float state `a` and the double reference's `r` after the same steps.
+RoundingBound rounding_bound(const State& a, const State& r, Bound floor, double times = 8);
+// A floor of 4 ulp of the state's largest coordinate (at least 1 mm's), for velocities turned
+// into a velocity by 1/dt (Verlet's v is a position difference over dt).
+Bound ulp_floor(const State& s, float dt);
+// `g` within `b` of `a`: positions and velocities, each by its largest node distance and its
+// root mean square, and previous positions by their largest; the message gives each.
+testing::AssertionResult within_rounding(const State& g, const State& a, const RoundingBound& b);
+
 // Equal bit for bit (positions, velocities, previous positions, time).
 bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
 bool bitwise_equal(const State& a, const State& b);
