@@ -39,6 +39,7 @@ int experiment_command(const ExperimentArgs& a) {
     if (!a.report_only) require_writable(dir);
     require_holds_nothing_but(dir, Holds::experiment);
     require_same_experiment(dir, x.name);
+    if (!a.report_only) require_sweep_folder(dir, *sweep);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
@@ -74,7 +75,7 @@ int experiment_command(const ExperimentArgs& a) {
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
           std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step"
-                    << (p.kept ? " (kept)" : "");
+                    << (p.kept ? " (kept)" : p.remeasured ? " (measured again: the scene or the sweep's method changed)" : "");
         else
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
         std::cout << "  [" << duration_text(p.elapsed_s);

@@ -49,6 +49,17 @@ void require_holds_nothing_but(const fs::path& dir, Holds want) {
                               ": give this " + (want == Holds::run ? "run" : "experiment") + " another --out");
 }
 
+std::string foreign_frames_entry(const fs::path& frames) {
+  std::error_code ec;
+  if (!fs::is_directory(frames, ec)) return "";
+  for (const auto& e : fs::directory_iterator(frames, ec)) {
+    const std::string name = e.path().filename().string();
+    const bool frame = name.starts_with("frame_") && name.ends_with(".png") && e.is_regular_file(ec);
+    if (!frame && !(name == "frames.mp4" && e.is_regular_file(ec))) return name;
+  }
+  return "";
+}
+
 fs::path temporary(const fs::path& name) { return name.string() + ".tmp-" + std::to_string(::getpid()); }
 
 namespace {
@@ -123,6 +134,10 @@ void OutputDir::require_ours(const std::vector<std::string>& writes) const {
       throw std::invalid_argument("output folder '" + dir_.string() + "' holds '" + name +
                                   "', which no earlier run's manifest there names (not a deformlab output): move it "
                                   "or give another --out");
+  // The earlier run's frames are replaced or removed as a whole.
+  if (const std::string e = earlier_.count("frames/") ? foreign_frames_entry(dir_ / "frames") : ""; !e.empty())
+    throw std::invalid_argument("output folder '" + dir_.string() + "' holds 'frames/" + e +
+                                "', which no run writes there: move it or give another --out");
 }
 
 OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes)

@@ -31,6 +31,11 @@ Holds folder_holds(const std::filesystem::path& dir);
 // Throws std::invalid_argument when `dir` holds the other kind of output than `want`.
 void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 
+// The first entry of the frames folder `frames` that no run writes there (frame_*.png,
+// frames.mp4), or "" (also where there is no such folder): a folder that holds one is not
+// removed or replaced.
+std::string foreign_frames_entry(const std::filesystem::path& frames);
+
 // The temporary name of `name` for this process: "<name>.tmp-<pid>".
 std::filesystem::path temporary(const std::filesystem::path& name);
 // Removes the temporaries in `dir` ("*.tmp-<pid>", ".staging-<pid>") whose process is gone.

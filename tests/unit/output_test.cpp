@@ -159,13 +159,26 @@ TEST(OutputDir, WhatNoRunWroteIsNotReplaced) {
   EXPECT_THROW(OutputDir(dir, kOutputs, with_frames), std::invalid_argument) << "a run that wrote no frames";
   EXPECT_EQ(read(dir / "frames" / "keep.txt"), "mine");
   write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": "", "frames/": ""}})");
+  // The earlier run's frames are replaced as a whole, but not with a file no run writes there.
+  for (const auto& writes : {with_frames, kWrites}) {
+    try {
+      OutputDir out(dir, kOutputs, writes);
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(e.what(), "output folder '" + dir.string() +
+                              "' holds 'frames/keep.txt', which no run writes there: move it or give another --out");
+    }
+  }
+  fs::remove(dir / "frames" / "keep.txt");
+  write(dir / "frames" / "frame_000010.png", "a frame");
+  write(dir / "frames" / "frames.mp4", "a movie");
   {
-    OutputDir out(dir, kOutputs, with_frames);  // the earlier run's frames: replaced
+    OutputDir out(dir, kOutputs, with_frames);
     fs::create_directories(out.staged("frames"));
     write(out.staged("manifest.json"), "new");
     out.commit();
   }
-  EXPECT_FALSE(fs::exists(dir / "frames" / "keep.txt"));
+  EXPECT_FALSE(fs::exists(dir / "frames" / "frame_000010.png"));
   // A manifest from before "frames/" was listed names the frames as "frames".
   write(dir / "manifest.json", R"({"experiment": "paper-drag", "files": {"summary.txt": ""}, "frames": {}})");
   EXPECT_NO_THROW(OutputDir(dir, kOutputs, with_frames));

@@ -106,6 +106,76 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   }
 }
 
+// A folder resumed with another scene or sweep method measures its cells again; the name, the
+// description and the sweep's lists of cells do not change how a cell is measured.
+TEST_F(SweepTest, CellsOfAnotherSceneOrMethodAreMeasuredAgain) {
+  const auto sweep = R"({"sizes": [4], "pipelines": ["cpu", "omp"], "warmup": 1, "steps": 2, "repetitions": 2})";
+  const Experiment x = tiny(sweep);
+  const Sweep s = *parse_sweep(x.raw, "tiny");
+  ASSERT_EQ(run_sweep(x, s, dir_, {}, json::array()), 2);
+  for (const auto& r : load_cells(dir_)) EXPECT_EQ(r["measurement"], measurement(x.raw)) << r.dump();
+  Experiment described = x;
+  described.raw["description"] = "the same cells";
+  described.raw["sweep"]["sizes"] = {4, 5};
+  EXPECT_EQ(run_sweep(described, *parse_sweep(described.raw, "tiny"), dir_, {}, json::array()), 2) << "only size 5";
+  Experiment slower = x;
+  slower.raw["scene"]["dt"] = 1e-4;
+  int remeasured = 0;
+  SweepOptions o;
+  o.on_cell = [&](const Cell&, const json&, const SweepProgress& p) { remeasured += p.remeasured; };
+  EXPECT_EQ(run_sweep(slower, s, dir_, o, json::array()), 2);
+  EXPECT_EQ(remeasured, 2);
+  Experiment longer = slower;
+  longer.raw["sweep"]["steps"] = 3;
+  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 2);
+  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 0);
+  // Cells from before "measurement" was recorded count as measured as the manifest says.
+  const fs::path cell = dir_ / "cells" / (Cell{4, "cpu", "midpoint", {}}.id() + ".json");
+  json r = json::parse(slurp(cell));
+  r.erase("measurement");
+  std::ofstream(cell) << r.dump();
+  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 0);
+  EXPECT_EQ(run_sweep(x, s, dir_, {}, json::array()), 2);
+}
+
+// A sweep refuses, before it runs, a folder where it would write over or remove what no
+// experiment wrote.
+TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
+  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})");
+  const Sweep s = *parse_sweep(x.raw, "tiny");
+  auto refusal = [&] {
+    try {
+      require_sweep_folder(dir_, s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refusal(), "") << "no folder yet";
+  for (const char* name : {"report.md", "plot-verlet.svg", "manifest.json", "frames/own.png"}) {
+    fs::remove_all(dir_);
+    fs::create_directories((dir_ / name).parent_path());
+    std::ofstream(dir_ / name) << "mine";
+    const std::string entry = fs::path(name).begin()->string();
+    EXPECT_NE(refusal().find("holds '" + entry + "', which no experiment wrote there"), std::string::npos) << name;
+  }
+  fs::remove_all(dir_);
+  std::ofstream((fs::create_directories(dir_), dir_ / "notes.txt")) << "mine";
+  EXPECT_EQ(refusal(), "") << "a file of another name is left alone";
+  ASSERT_EQ(run_sweep(x, s, dir_, {}, json::array()), 1);
+  EXPECT_EQ(refusal(), "");
+  std::ofstream(dir_ / "cells" / (Cell{4, "cpu", "midpoint", {}}.id() + ".json")) << "damaged";
+  EXPECT_EQ(refusal(), "") << "a damaged cell of the sweep is measured again";
+  std::ofstream(dir_ / "cells" / "notes.json") << "mine";
+  EXPECT_NE(refusal().find("holds 'cells/notes.json', which is not a cell result"), std::string::npos);
+  fs::remove(dir_ / "cells" / "notes.json");
+  fs::create_directories(dir_ / "frames");
+  std::ofstream(dir_ / "frames" / "frame_000001.png") << "a frame";
+  EXPECT_EQ(refusal(), "");
+  std::ofstream(dir_ / "frames" / "own.txt") << "mine";
+  EXPECT_NE(refusal().find("holds 'frames/own.txt', which no run writes there"), std::string::npos);
+}
+
 // Under --max-size the experiment's own grid, if larger, leaves its frames for a later run, as
 // it leaves the sweep's larger sizes; the run without it renders them (or says why it cannot).
 TEST_F(SweepTest, FramesOfAGridOverMaxSizeWaitForALaterRun) {
