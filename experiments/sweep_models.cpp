@@ -62,6 +62,11 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
+    try {
+      check_mesh_file(scene.model);
+    } catch (const std::invalid_argument& e) {
+      bad(w, e.what());
+    }
   }
 }
 

@@ -16,9 +16,9 @@ std::vector<SweepModel> parse_sweep_models(const nlohmann::json& j, const std::s
 // "orders": node order names, distinct.
 std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::string& where);
 
-// Throws std::invalid_argument naming the first model whose mesh file is missing (relative
-// files from the experiment's folder; `where` names the experiment file in the message):
-// checked before the first cell runs.
+// Throws std::invalid_argument naming the first model whose mesh file is missing or cannot be
+// read and repaired (check_mesh_file; relative files from the experiment's folder; `where`
+// names the experiment file in the message): checked before the first cell runs.
 void require_model_files(const Experiment& x, const Sweep& s, const std::string& where);
 
 // The experiment's scene with a model cell's model (relative files from the experiment's

@@ -6,11 +6,13 @@
 #include <assimp/version.h>
 #include <gmsh.h>
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <unordered_map>
+#include <vector>
 
 #include "child_read.hpp"
 #include "gmsh_session.hpp"
@@ -60,10 +62,19 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   // vertices would otherwise merge a NaN vertex into another and hide it.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
   if (!scene) refused_by_assimp(path, importer);
-  for (unsigned k = 0; k < scene->mNumMeshes; ++k)
-    for (unsigned v = 0; v < scene->mMeshes[k]->mNumVertices; ++v)
-      if (const aiVector3D& a = scene->mMeshes[k]->mVertices[v]; !finite_vertex({a.x, a.y, a.z}))
-        bad(path, non_finite_vertex({a.x, a.y, a.z}));
+  // Joining identical vertices also drops those no face uses, unseen: counted here.
+  std::int64_t unused = 0;
+  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+    const aiMesh* a = scene->mMeshes[k];
+    for (unsigned v = 0; v < a->mNumVertices; ++v)
+      if (const aiVector3D& p = a->mVertices[v]; !finite_vertex({p.x, p.y, p.z})) bad(path, non_finite_vertex({p.x, p.y, p.z}));
+    std::vector<bool> used(a->mNumVertices);
+    for (unsigned f = 0; f < a->mNumFaces; ++f)
+      for (unsigned i = 0; i < a->mFaces[f].mNumIndices; ++i)
+        if (a->mFaces[f].mIndices[i] < a->mNumVertices) used[a->mFaces[f].mIndices[i]] = true;
+    unused += std::count(used.begin(), used.end(), false);
+  }
+  if (unused) notes.push_back("dropped " + std::to_string(unused) + " unreferenced vertices");
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
                                        aiProcess_SortByPType | aiProcess_ValidateDataStructure);

@@ -138,6 +138,20 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
   return generate_shape(shape, save_to);
 }
 
+void check_mesh_file(const ModelSpec& spec) {
+  const MeshSpec& ms = spec.mesh;
+  if (ms.generate || ms.file.empty()) return;
+  std::vector<std::string> notes;
+  std::string what;
+  Mesh mesh = source_mesh(ms, what, notes);
+  naming(what, [&] {
+    place(mesh, ms);
+    repair(mesh);
+    if (!ms.fill) check_memory(mesh);
+    return ms.fill ? Model{} : mesh_model(mesh, spec.material, ms.density);  // its springs: a non-manifold edge
+  });
+}
+
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to) {
   if (!ms.fill) throw std::logic_error("filled_mesh of a model without \"fill\"");
   std::vector<std::string> notes;
