@@ -96,6 +96,18 @@ TEST(Scene, ALayersSpacingOrWidthReplacesTheOther) {
   EXPECT_EQ(to_json(t), to_json(s));
 }
 
+// A max_steps below the min_steps a scene would take (the default's 100, a base's) lowers them,
+// since the stop rule can start no later than the last step; a min_steps given beside it cannot.
+TEST(Scene, AMaxStepsBelowTheMinStepsLowersThem) {
+  Scene s;
+  apply_json(s, json::parse(R"({"max_steps": 50})"), "a");
+  EXPECT_EQ(s.params.min_steps, 50);
+  EXPECT_EQ(s.params.max_steps, 50);
+  apply_json(s, json::parse(R"({"max_steps": 500})"), "b");
+  EXPECT_EQ(s.params.min_steps, 50) << "raising max_steps leaves min_steps";
+  EXPECT_THROW(apply_json(s, json::parse(R"({"min_steps": 60, "max_steps": 40})"), "c"), std::invalid_argument);
+}
+
 // A grid one node wide spans `width` along its next axis with more than one node, as a wider
 // one does along x: a 1 x 64 cloth is 1 m long, as a 64 x 1 one is 1 m wide.
 TEST(Scene, AGridOneNodeWideSpansItsWidthAlongItsLength) {
