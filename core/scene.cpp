@@ -299,7 +299,13 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     m.spacing = 0;
   }
   if (j.contains("height")) m.height = num(j["height"], where + ".height");
-  if (j.contains("node_mass")) m.material.node_mass = num(j["node_mass"], where + ".node_mass", Range::positive);
+  // A mesh's masses come from `density` or `node_mass`: a layer gives one and replaces the other.
+  if (j.contains("node_mass")) {
+    if (mesh && j.contains("density"))
+      bad(where + ".node_mass", "give density or node_mass, not both (each sets the masses)");
+    m.material.node_mass = num(j["node_mass"], where + ".node_mass", Range::positive);
+    m.mesh.density = 0.f;
+  }
   if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness", Range::positive);
   if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
@@ -511,7 +517,7 @@ json to_json(const Scene& s) {
     } else {
       model.update({{"file", ms.file}, {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size}});
     }
-    if (ms.density > 0) model["density"] = ms.density;
+    if (ms.density > 0) model["density"] = ms.density, model.erase("node_mass");  // it sets the masses
   } else {
     model.update({{"type", m.topology == Topology::lattice ? "lattice" : "cloth"}, {"height", m.height}});
     if (m.spacing > 0) model["spacing"] = m.spacing;  // it sets the width

@@ -167,6 +167,8 @@ const std::vector<BadInput>& cases() {
       scene("drag_keyframe_negative_time", "{\"drag\": {\"node\": 0, \"path\": [[-1, 0, 0, 0]]}}",
             "s.json.drag.path[0][0]: expected a number >= 0"),
       // mesh models: the file (named relative to the scene) and the keys
+      mesh("mesh_density_and_node_mass", "{\"file\": \"m.obj\", \"density\": 1, \"node_mass\": 0.01}",
+           "s.json.model.node_mass: give density or node_mass, not both"),
       mesh("mesh_file_missing", "{\"file\": \"none.obj\"}", "none.obj': no such file"),
       mesh("mesh_file_directory", "{\"file\": \"/\"}", "mesh file '/': a directory, not a mesh file"),
       mesh("mesh_file_empty", "{\"file\": \"m.obj\"}", "m.obj': the file is empty", ""),

@@ -96,6 +96,22 @@ TEST(Scene, ALayersSpacingOrWidthReplacesTheOther) {
   EXPECT_EQ(to_json(t), to_json(s));
 }
 
+// A mesh's masses come from density or node_mass: a later layer's replaces the earlier's, and
+// the scene as JSON reads back the same.
+TEST(Scene, ALayersDensityOrNodeMassReplacesTheOther) {
+  Scene s;
+  apply_json(s, json::parse(R"({"model": {"type": "mesh", "file": "m.obj", "density": 1000}})"), "a");
+  EXPECT_EQ(s.model.mesh.density, 1000.f);
+  EXPECT_EQ(to_json(s)["model"].count("node_mass"), 0u);
+  Scene t;
+  apply_json(t, to_json(s), "t");
+  EXPECT_EQ(to_json(t), to_json(s));
+  apply_json(s, json::parse(R"({"model": {"node_mass": 0.02}})"), "b");
+  EXPECT_EQ(s.model.mesh.density, 0.f);
+  EXPECT_EQ(s.model.material.node_mass, 0.02f);
+  EXPECT_EQ(to_json(s)["model"].count("density"), 0u);
+}
+
 // A max_steps below the min_steps a scene would take (the default's 100, a base's) lowers them,
 // since the stop rule can start no later than the last step; a min_steps given beside it cannot.
 TEST(Scene, AMaxStepsBelowTheMinStepsLowersThem) {
