@@ -4,6 +4,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include "commands.hpp"
@@ -48,6 +49,16 @@ struct Ran {
 
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
 // renders into the staged frames/ folder.
+// When a convergence run's stop rule starts, in words.
+std::string stop_rule_start(const Params& p) {
+  const std::string why = p.drag.active() ? " (min_steps and the drag path's end at t = " +
+                                                significant_trimmed(p.drag.end_time(), 6) + " s)"
+                                          : " (min_steps)";
+  const int step = first_stop_step(p);
+  return step == std::numeric_limits<int>::max() ? "the stop rule starts past the last step an int counts" + why
+                                                  : "the stop rule starts at step " + std::to_string(step) + why;
+}
+
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {
   // Untimed steps from rest for --warmup-ms (by default kGpuWarmUpMs where a pass runs on a GPU).
   const double warm_ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);
@@ -196,8 +207,7 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
     std::cout << "converged: no node moved more than " << significant_trimmed(in.params.threshold, 3)
               << " m in the last step\n";
   else if (in.until_converged && r.steps < first_stop_step(in.params))
-    std::cout << "not converged: the stop rule starts at step " << first_stop_step(in.params)
-              << " (min_steps and the drag path's end), after max_steps\n";
+    std::cout << "not converged: " << stop_rule_start(in.params) << ", after max_steps\n";
   else if (in.until_converged)
     std::cout << "not converged by max_steps: the last check found a node moving "
               << significant_trimmed(r.last_displacement, 3) << " m in a step, over the threshold "
@@ -273,6 +283,9 @@ int run_command(const RunArgs& a) {
       std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
                 << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
                 << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
+    if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
+      std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
+                << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";
     if (in.entry->name == "cuda-temporal" && in.model.volume())
       std::cerr << "deformlab: note: on lattices cuda-temporal took longer a step than cuda-fused at every "
                 << "steps_per_launch and tile measured (H100, 256^3: a node's 32 springs bind the step to arithmetic, "

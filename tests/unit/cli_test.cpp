@@ -236,6 +236,19 @@ TEST_F(Cli, NotesADtOverTheStabilityBound) {
   EXPECT_EQ(under.err.find("stability bound"), std::string::npos) << under.err;
 }
 
+// A convergence run whose stop rule would start after max_steps says so before it runs and
+// after; a scene file sets max_steps low, so that the run is short.
+TEST_F(Cli, NotesAStopRuleThatStartsAfterMaxSteps) {
+  write("s.json", R"({"model": {"size": [8, 8]}, "dt": 0.001, "max_steps": 200,
+                      "drag": {"node": "center", "path": [[0.5, 0, 1, 0]]}})");
+  const Result r = run("run --pipeline cpu --scene " + (dir_ / "s.json").string() + " --out " + (dir_ / "o").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string start = "the stop rule starts at step 500 (min_steps and the drag path's end at t = 0.5 s), after max_steps";
+  EXPECT_NE(r.err.find("note: " + start + " (200): this run takes 200 steps and cannot converge"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("not converged: " + start + "\n"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, PapersAliasesAndLattices) {
   const Result r = run("run --pipeline omp --integrator implicit-euler --lattice 4x3x5 --steps 5 --out " +
                        (dir_ / "lat").string());
