@@ -16,6 +16,7 @@ TEST(SweepFrames, CellsTimeAStepAndADraw) {
       "frames.json");
   const Sweep s = *parse_sweep(x.raw, "frames");
   ModelCache cache;
+  ASSERT_EQ(cells(s).size(), 2u);
   for (const auto& c : cells(s)) {
     const auto r = run_cell(x, s, c, cache);
     ASSERT_EQ(r["status"], "ok") << r.dump();

@@ -50,6 +50,7 @@ const Shape kShapes[] = {
     {"surface30x20", 30, 20, 0, true, true, false, Shape::surface},
     {"volume8x6x5", 8, 6, 5, true, true, false, Shape::volume},
     {"general11x7", 11, 7, 0, false, true},  // undamped adjacency: no neighbour velocities read
+    {"cloth1x1", 1, 1, 0, false},  // one free node and no springs
 };
 
 // Option values tried beyond the defaults, by option name (PipelineEntry::options), the
@@ -72,6 +73,7 @@ const OptionValues kOptionValues[] = {
     {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
     {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
     {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
+    {"window", {"400"}, {0, 6}, kOnePassAndRk4},  // glsl-compute's passes window by window (grids)
     // cuda-temporal: launches of 1 and 3 steps (50 = 16 x 3 + 2)
     {"steps_per_launch", {"1", "3"}, {1, 3, 6}, kOnePassAndRk4},
     {"math", {"fast"}, {0, 6, 7, 9}, kOnePassAndRk4},  // exact is the default: every case above runs it
@@ -109,7 +111,7 @@ Model make_model(const Shape& s) {
     reorder(m, node_order(m, NodeOrder::shuffled, 11));
     return m;
   }
-  Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny);
+  Model m = s.nz > 0 ? small_lattice(s.nx, s.ny, s.nz) : small_cloth(s.nx, s.ny, s.nx * s.ny > 1);  // 1x1: free
   if (s.damped) m.damping = {0.02f, 0.02f, 0.01f};
   return s.general ? explicit_springs(m) : m;
 }

@@ -260,9 +260,10 @@ TEST_F(Cli, PapersAliasesAndLattices) {
 TEST_F(Cli, ListShowsEveryPipelineAndIntegrator) {
   const Result r = run("list");
   ASSERT_EQ(r.code, 0);
-  for (const char* name : {"cpu", "omp", "glsl-tf", "glsl-compute", "cuda-naive", "cuda-tiled", "cuda-scatter",
-                           "cuda-fused", "hybrid", "hybrid-compute", "explicit-euler", "semi-implicit-euler",
-                           "midpoint", "rk4", "verlet", "backward-euler", "implicit-euler"})
+  for (const char* name : {"cpu", "omp", "reference", "glsl-tf", "glsl-compute", "cuda-naive", "cuda-tiled",
+                           "cuda-scatter", "cuda-fused", "cuda-temporal", "hybrid", "hybrid-compute", "explicit-euler",
+                           "semi-implicit-euler", "midpoint", "rk3", "rk4", "verlet", "backward-euler",
+                           "implicit-euler"})
     EXPECT_NE(r.out.find(name), std::string::npos) << name;
   // Each pipeline's options with the values they take, every option's values known.
   EXPECT_NE(r.out.find("options: tile=WxH tma=on|off math=exact|fast\n"), std::string::npos) << r.out;
