@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
   deformlab::app::CalibrateArgs cal;
   cal.argv = a.argv;
   auto* calibrate = cli.add_subcommand(
-      "calibrate", "Measure this device's ceilings (copy, transform feedback, compute, interop hand-offs) as JSON");
+      "calibrate", "Measure this device's ceilings (copy, transform feedback, compute, interop hand-offs) as JSON; "
+                   "needs CUDA and OpenGL on one GPU");
   calibrate->add_option("--out,-o", cal.out, "JSON file to write (default: standard output)");
 
   deformlab::app::MeshArgs mesh_args;

@@ -1,5 +1,8 @@
 // `deformlab view`: the scene in a window (viewer/).
+#include <filesystem>
+#include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "commands.hpp"
 #include "run_input.hpp"
@@ -9,6 +12,20 @@
 #endif
 
 namespace deformlab::app {
+namespace {
+
+// Throws std::invalid_argument where `file`, named by `what`, could not be written: a folder in
+// its place, or no folder to hold it.
+void require_file_target(const std::string& file, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder = fs::path(file).parent_path();
+  if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
+  if (!folder.empty() && !fs::is_directory(folder, ec))
+    throw std::invalid_argument(what + " '" + file + "': no folder '" + folder.string() + "'");
+}
+
+}  // namespace
 
 int view_command(const ViewArgs& a) {
   return report_errors([&]() -> int {
@@ -19,10 +36,19 @@ int view_command(const ViewArgs& a) {
     const std::vector<int> size = parse_size(a.size, 2, "--size");
     check_run_flags(a.run);
     if (size[0] > 16384 || size[1] > 16384) throw std::invalid_argument("--size: at most 16384x16384");
+    std::set<std::string> files;
+    for (const auto& [flag, file] : {std::pair{"--summary", a.summary}, {"--save-script", a.save_script}, {"--record", a.record}}) {
+      if (!file) continue;
+      require_file_target(*file, flag);
+      if (!files.insert(std::filesystem::absolute(*file).lexically_normal().string()).second)
+        throw std::invalid_argument(std::string(flag) + " '" + *file + "' is a file another flag writes too");
+    }
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;
     o.steps_per_frame = a.steps_per_frame;
     if (a.script) o.script = viewer::read_script(*a.script);
+    for (const viewer::Event& e : o.script)
+      if (e.kind == viewer::Event::Kind::screenshot) require_file_target(e.file, "script " + *a.script + ": screenshot");
     o.save_script = a.save_script.value_or("");
     o.record = a.record.value_or("");
     o.seconds = a.seconds.value_or(0.0);

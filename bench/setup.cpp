@@ -1,5 +1,6 @@
 // The benches' shared scene, flags, statistics and CSV files (bench.hpp).
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -8,6 +9,7 @@
 
 #include "bench.hpp"
 #include "core/profiler.hpp"
+#include "core/write_error.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
 #include "mesh/scene_model.hpp"
@@ -84,7 +86,8 @@ Integrator BenchOptions::integ() const {
 }
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
-  c.add_option("--sizes", o.sizes, "Grid sizes (n for n x n)")->check(CLI::Range(1, 1 << 17));
+  c.add_option("--sizes", o.sizes, "Grid sizes n (n x n nodes), 2 and up")
+      ->check(CLI::Range(2, 1 << 17));
   c.add_flag("--idealised", o.idealised,
              "Time the idealised scene (undamped, no contact, no drag) in place of the paper's (table2's)");
   c.add_option("--warmup", o.warmup, "Warm-up steps (0: none)")->check(CLI::Range(0, std::numeric_limits<int>::max()));
@@ -113,8 +116,9 @@ std::string run_columns(const BenchOptions& o) {
 std::ofstream open_csv(const std::string& path, const char* header, const char* tail) {
   std::ofstream csv;
   if (path.empty()) return csv;
+  errno = 0;
   csv.open(path);
-  if (!csv) throw std::invalid_argument("cannot write " + path);
+  if (!csv) throw std::invalid_argument(write_error(path).what());  // with the system's reason
   csv << header << tail << "\n";
   return csv;
 }

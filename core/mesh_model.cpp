@@ -186,7 +186,7 @@ void walk_sides(std::vector<Side<N>>& sides, std::vector<Key>& flexion, Boundary
         nodes += std::to_string(v);
       }
       bad(std::string(N == 2 ? "edge " : "face ") + nodes + " is shared by " + std::to_string(b - a) +
-          (N == 2 ? " triangles" : " tetrahedra") + " (non-manifold)");
+          (N == 2 ? " triangles" : " tetrahedra") + " (non-manifold; node indices from 0, as pins take them)");
     }
   }
 }

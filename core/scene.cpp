@@ -156,6 +156,11 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
         else if (v != (c == 3 ? 1.f : 0.f)) bad(w, "the last row of an affine map is [0, 0, 0, 1]");
       }
     }
+    const auto at = [&](int r, int c) { return double(t[r * 4 + c]); };
+    const double det = at(0, 0) * (at(1, 1) * at(2, 2) - at(1, 2) * at(2, 1)) -
+                       at(0, 1) * (at(1, 0) * at(2, 2) - at(1, 2) * at(2, 0)) +
+                       at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
+    if (det == 0.0) bad(where, "its 3 x 3 part is singular: it would flatten the mesh");
     return t;
   }
   only_keys(j, where, {"rotate", "translate"});

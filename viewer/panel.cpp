@@ -127,11 +127,15 @@ PanelActions show_panel(PanelState& p, const Stats& s, Session& session, const s
 
   ImGui::Separator();
   ImGui::Text("t = %.4f s, step %d", session.time(), session.steps());
-  ImGui::TextWrapped("%.0f steps/s, %.1f frames/s (host clock)", s.steps_per_s, s.frames_per_s);
-  ImGui::TextWrapped("step %.4f ms (%s)", s.step_ms, s.step_clock.c_str());
-  ImGui::TextWrapped("largest displacement %.3g m", s.displacement);
-  ImGui::TextWrapped("draw %.3f ms (%s)", s.draw_ms, s.draw_clock.c_str());
-  ImGui::TextWrapped("drawn from %s", s.drawn_from.c_str());
+  if (s.measured) {
+    ImGui::TextWrapped("%.0f steps/s, %.1f frames/s (host clock)", s.steps_per_s, s.frames_per_s);
+    ImGui::TextWrapped("step %.4f ms (%s)", s.step_ms, s.step_clock.c_str());
+    ImGui::TextWrapped("largest displacement %.3g m", s.displacement);
+    ImGui::TextWrapped("draw %.3f ms (%s)", s.draw_ms, s.draw_clock.c_str());
+    ImGui::TextWrapped("drawn from %s", s.drawn_from.c_str());
+  } else {
+    ImGui::TextDisabled("timings after the first half second");
+  }
   if (ImGui::Checkbox("stage timings", &p.profile)) a.profile_changed = true;
   if (p.profile) stage_bars(s);
   if (!message.empty()) {

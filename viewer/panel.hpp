@@ -24,8 +24,9 @@ struct PanelState {
   std::string option_text, dt_text;
 };
 
-// Measured over the last half second.
+// Measured over the last half second (none yet in the first).
 struct Stats {
+  bool measured = false;
   double steps_per_s = 0, frames_per_s = 0;  // host clock
   double step_ms = 0;                        // median, on step_clock
   std::string step_clock;

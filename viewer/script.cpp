@@ -1,5 +1,7 @@
 #include "script.hpp"
 
+#include <climits>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -29,21 +31,37 @@ Event from_json(const nlohmann::json& j) {
   for (const auto& [name, k] : kKinds)
     if (kind == name) e.kind = k, known = true;
   if (!known) throw std::invalid_argument("unknown event '" + kind + "'");
+  auto text = [](const nlohmann::json& v, const std::string& key) {
+    if (!v.is_string()) throw std::invalid_argument(key + " must be a string");
+    return v.get<std::string>();
+  };
+  auto number = [](const nlohmann::json& v, const std::string& key) {
+    if (!v.is_number()) throw std::invalid_argument(key + " must be a number");
+    return v.get<double>();
+  };
   for (const auto& [key, v] : j.items()) {
     if (key == "event") continue;
-    if (key == "frame") e.frame = v.get<int>();
-    else if (key == "x") e.x = v.get<double>();
-    else if (key == "y") e.y = v.get<double>();
-    else if (key == "button") e.button = v.get<std::string>();
-    else if (key == "shift") e.shift = v.get<bool>();
-    else if (key == "key") e.key = v.get<std::string>();
-    else if (key == "file") e.file = v.get<std::string>();
+    if (key == "frame") {
+      if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > INT_MAX)
+        throw std::invalid_argument("frame must be a whole number >= 0");
+      e.frame = v.get<int>();
+    } else if (key == "x") e.x = number(v, key);
+    else if (key == "y") e.y = number(v, key);
+    else if (key == "button") e.button = text(v, key);
+    else if (key == "shift") {
+      if (!v.is_boolean()) throw std::invalid_argument("shift must be true or false");
+      e.shift = v.get<bool>();
+    } else if (key == "key") {
+      e.key = text(v, key);
+      const bool letter = e.key.size() == 1 && e.key[0] >= 'a' && e.key[0] <= 'z';
+      if (!letter && e.key != "space" && e.key != "backspace")
+        throw std::invalid_argument("key '" + e.key + "' is not a key name (a-z, space, backspace)");
+    } else if (key == "file") e.file = text(v, key);
     else if (e.kind == Event::Kind::set && (key == "pipeline" || key == "integrator" || key == "dt" || key == "options"))
       e.settings[key] = v.is_string() ? v.get<std::string>() : v.dump();
     else
       throw std::invalid_argument("unknown key '" + key + "'");
   }
-  if (e.frame < 0) throw std::invalid_argument("frame must be >= 0");
   if (e.kind == Event::Kind::press && e.button != "left" && e.button != "right" && e.button != "middle")
     throw std::invalid_argument("button must be left, right or middle");
   if (e.kind == Event::Kind::screenshot && e.file.empty()) throw std::invalid_argument("a screenshot needs a file");

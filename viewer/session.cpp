@@ -16,6 +16,7 @@ std::unique_ptr<Pipeline> Session::make(const PipelineEntry& e, Integrator i, co
                                         const Params& p) {
   if (const std::string why = e.unavailable(); !why.empty()) throw std::invalid_argument(e.name + ": " + why);
   if (const std::string why = e.unsupported(i); !why.empty()) throw std::invalid_argument(e.name + ": " + why);
+  check_options(e, o);  // names and values, as `run` checks them
   validate(p, s_.model.node_count());
   auto pipe = e.make({s_.model, p, i, o});
   pipe->set_drag(handle_);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,11 @@ using Clock = std::chrono::steady_clock;
 
 nlohmann::json to_json(Vec3f v) { return {v.x, v.y, v.z}; }
 
+// SIGINT or SIGTERM asks the loop to end as the window's close button does, so that the
+// recording, the script and the summary are still written.
+volatile std::sig_atomic_t g_signal = 0;
+void on_signal(int sig) { g_signal = sig; }
+
 class Viewer {
  public:
   Viewer(Window& w, Session& s, const ViewOptions& o)
@@ -48,7 +54,7 @@ class Viewer {
   int loop() {
     int code = 0;
     const int video_frames = o_.seconds > 0 ? int(std::lround(o_.seconds * kVideoFps)) : 0;
-    while (!quit_ && !w_.should_close()) {
+    while (!quit_ && !w_.should_close() && !g_signal) {
       std::vector<Event> events;
       for (; next_ < script_.size() && script_[next_].frame <= frame_; ++next_) events.push_back(script_[next_]);
       w_.poll(frame_, events);
@@ -62,6 +68,9 @@ class Viewer {
       ++frame_;
       if ((o_.frames > 0 && frame_ >= o_.frames) || (video_frames > 0 && frame_ >= video_frames)) quit_ = true;
     }
+    if (g_signal)
+      std::cerr << "deformlab: note: " << (g_signal == SIGINT ? "SIGINT" : "SIGTERM") << " at frame " << frame_
+                << ": ending the session as its window's close does\n";
     try {
       if (rec_) finish_recording();
       if (!o_.save_script.empty()) write_script(o_.save_script, recorded_);
@@ -334,6 +343,7 @@ class Viewer {
   void refresh_stats() {
     const double since = std::chrono::duration<double>(Clock::now() - window_start_).count();
     if (since < 0.5) return;
+    stats_.measured = true;
     stats_.steps_per_s = steps_in_window_ / since;
     stats_.frames_per_s = (frame_ - window_frame_) / since;
     stats_.step_ms = median(timer_->take());
@@ -433,6 +443,16 @@ class Viewer {
 
 }  // namespace
 
-int run(Window& w, Session& s, const ViewOptions& o) { return Viewer(w, s, o).loop(); }
+int run(Window& w, Session& s, const ViewOptions& o) {
+  struct Handlers {  // on_signal while the loop runs
+    Handlers() : sigint(std::signal(SIGINT, on_signal)), sigterm(std::signal(SIGTERM, on_signal)) { g_signal = 0; }
+    ~Handlers() {
+      std::signal(SIGINT, sigint);
+      std::signal(SIGTERM, sigterm);
+    }
+    void (*sigint)(int), (*sigterm)(int);
+  } handlers;
+  return Viewer(w, s, o).loop();
+}
 
 }  // namespace deformlab::viewer

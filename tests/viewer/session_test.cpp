@@ -1,8 +1,12 @@
 // The viewer's simulation without a window: pipelines replaced mid-run with the state carried
-// over, the drag handle of picking, pins toggled, reset; picking and the camera's moves.
+// over, the drag handle of picking, pins toggled, reset; picking and the camera's moves; the
+// script file's events read as typed.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "core/run.hpp"
 #include "experiments/pipelines.hpp"
@@ -10,6 +14,7 @@
 #include "gl/render.hpp"
 #include "tests/support/test_states.hpp"
 #include "viewer/orbit.hpp"
+#include "viewer/script.hpp"
 #include "viewer/session.hpp"
 
 namespace deformlab::test {
@@ -94,6 +99,44 @@ TEST(ViewerSession, AReplacementThatCannotBeMadeKeepsThePipeline) {
   EXPECT_NE(why.find("dt"), std::string::npos) << why;
   EXPECT_EQ(s.entry().name, "cpu");
   EXPECT_TRUE(bitwise_equal(s.pipeline().state(), before));
+  // Options are checked as `run` checks them: a name the pipeline does not read, a value it cannot.
+  EXPECT_EQ(s.replace(*pipelines().find("omp"), Integrator::semi_implicit_euler, {{"bogus", "1"}}, 1e-3f),
+            "option 'bogus' is not an option of omp (it has none)");
+  const PipelineEntry& compute = *pipelines().find("glsl-compute");
+  if (compute.read_options && compute.unavailable().empty()) {
+    EXPECT_EQ(s.replace(compute, Integrator::semi_implicit_euler, {{"math", "slow"}}, 1e-3f),
+              "glsl-compute: option math 'slow' is not exact or fast");
+  }
+  EXPECT_EQ(s.entry().name, "cpu");
+}
+
+// A script's events are read as typed: each mistyped value or unknown key name is refused with
+// the file and the event's index; an event file written back reads the same.
+TEST(ViewerScript, MistypedEventsAreRefusedByIndex) {
+  const auto file = std::filesystem::temp_directory_path() / ("deformlab-script-" + std::to_string(::getpid()) + ".json");
+  auto refusal = [&](const std::string& event) {
+    std::ofstream(file) << R"({"events": [{"frame": 0, "event": "quit"}, )" + event + "]}";
+    try {
+      viewer::read_script(file.string());
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string at = "script file " + file.string() + ", event 1: ";
+  EXPECT_EQ(refusal(R"({"frame": "x", "event": "quit"})"), at + "frame must be a whole number >= 0");
+  EXPECT_EQ(refusal(R"({"frame": 1.5, "event": "quit"})"), at + "frame must be a whole number >= 0");
+  EXPECT_EQ(refusal(R"({"frame": -1, "event": "quit"})"), at + "frame must be a whole number >= 0");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "zz"})"), at + "key 'zz' is not a key name (a-z, space, backspace)");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "move", "x": "left"})"), at + "x must be a number");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "press", "shift": 1})"), at + "shift must be true or false");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "screenshot", "file": 3})"), at + "file must be a string");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "w"})"), "");
+  const std::vector<viewer::Event> events = viewer::read_script(file.string());
+  viewer::write_script(file.string(), events);
+  ASSERT_EQ(viewer::read_script(file.string()).size(), 2u);
+  EXPECT_EQ(viewer::to_json(viewer::read_script(file.string())[1]), viewer::to_json(events[1]));
+  std::filesystem::remove(file);
 }
 
 TEST(ViewerSession, DraggedNodeSitsOnItsTargetAndMovesOnceReleased) {

@@ -187,8 +187,13 @@ TEST_F(View, KeysTakeScreenshotsAndRecordingsIntoTheWorkingFolder) {
 
 TEST_F(View, RefusesBadInputWithOneLine) {
   const fs::path bad = write("bad.json", R"({"events": [{"frame": 1, "event": "teleport"}]})");
+  const fs::path shot = write("shot.json", R"({"events": [{"frame": 1, "event": "screenshot", "file": "nodir/x.png"}]})");
+  const std::string same = (dir_ / "same.json").string();
   for (const auto& [args, needle] : std::vector<std::pair<std::string, std::string>>{
            {"--steps-per-frame 0", "--steps-per-frame"},
+           {"--summary " + (dir_ / "nodir" / "s.json").string(), "--summary '" + (dir_ / "nodir" / "s.json").string() + "': no folder"},
+           {"--summary " + same + " --save-script " + same, "--save-script '" + same + "' is a file another flag writes too"},
+           {"--script " + shot.string(), "screenshot 'nodir/x.png': no folder 'nodir'"},
            {"--seconds 2", "--seconds needs --record"},
            {"--size 640", "--size"},
            {"--script " + bad.string(), "unknown event 'teleport'"},
@@ -198,6 +203,15 @@ TEST_F(View, RefusesBadInputWithOneLine) {
     EXPECT_EQ(r.err.rfind("deformlab: error: ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
   }
+}
+
+// SIGINT ends a session as closing its window does: its summary is written, exit 0.
+TEST_F(View, SigintEndsTheSessionWithItsFiles) {
+  const Result r = run_wrapped("xvfb-run -a -s '-screen 0 1600x1000x24' timeout --preserve-status -s INT 8 ",
+                               "view --scene " + scene_.string() + " --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("deformlab: note: SIGINT at frame "), std::string::npos) << r.err;
+  EXPECT_GT(summary()["frames"].get<int>(), 0);
 }
 
 // With no display: stderr of `deformlab view ARGS`, which must exit 2 with one line.
