@@ -160,10 +160,11 @@ void run_gl(const StepOptions& o) {
             << "pass-through: transform feedback copying the two vec4 attributes (no physics), "
                "the ceiling of the transform-feedback route\n"
             << "bare gather: glsl-compute's loads and stores (its work groups and stencil) without its arithmetic; "
-               "glsl-compute in exact and fast math\n\n"
+               "glsl-compute in exact and fast math\n"
+            << "X of Y: Y's time over X's, the share of Y's speed that X reaches (ms columns: ms a step)\n\n"
             << std::setw(8) << "grid" << std::setw(16) << "pass-through" << std::setw(12) << "glsl-tf"
-            << std::setw(14) << "tf/ceiling" << std::setw(14) << "bare gather" << std::setw(15) << "compute exact"
-            << std::setw(14) << "compute fast" << std::setw(12) << "fast/bare" << "\n";
+            << std::setw(14) << "tf of ceiling" << std::setw(14) << "bare gather" << std::setw(15) << "compute exact"
+            << std::setw(14) << "compute fast" << std::setw(14) << "fast of bare" << "\n";
   ClockTally clocks;
   std::string memory;  // where the node buffers live, as the registry's pipelines chose
   // The registry's pipelines, as `deformlab run` makes them.
@@ -197,9 +198,10 @@ void run_gl(const StepOptions& o) {
       compute_fast = time_pipeline(*pipe, m, o);
     }
     std::cout << std::setw(8) << (std::to_string(n) + "^2") << std::fixed << std::setprecision(3) << std::setw(16)
-              << ceiling.median << std::setw(12) << tf.median << std::setw(14) << tf.median / ceiling.median
-              << std::setw(14) << bare.median << std::setw(15) << compute.median << std::setw(14)
-              << compute_fast.median << std::setw(12) << compute_fast.median / bare.median
+              << ceiling.median << std::setw(12) << tf.median << std::setw(14)
+              << fixed(100 * ceiling.median / tf.median, 1) + "%" << std::setw(14) << bare.median << std::setw(15)
+              << compute.median << std::setw(14) << compute_fast.median << std::setw(14)
+              << fixed(100 * bare.median / compute_fast.median, 1) + "%"
               << (neighbours == "grid arithmetic" ? "" : "  (" + neighbours + ")") << "\n";
     const std::pair<const char*, Stats> rows[] = {
         {"passthrough-tf", ceiling}, {"glsl-tf", tf}, {"compute-bare-gather", bare}, {"glsl-compute", compute},
