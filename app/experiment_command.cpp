@@ -1,5 +1,6 @@
 #include <filesystem>
 #include <iostream>
+#include <new>
 
 #include "commands.hpp"
 #include "run_input.hpp"
@@ -10,6 +11,7 @@
 #include "experiments/output.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
+#include "experiments/sweep_folder.hpp"
 #include "experiments/sweep_models.hpp"
 
 namespace deformlab::app {
@@ -27,7 +29,6 @@ int experiment_command(const ExperimentArgs& a) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");
     }
-    if (!a.report_only) require_model_files(x, *sweep, a.file);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
@@ -39,10 +40,14 @@ int experiment_command(const ExperimentArgs& a) {
     if (!a.report_only) require_writable(dir);
     require_holds_nothing_but(dir, Holds::experiment);
     require_same_experiment(dir, x.name);
-    if (!a.report_only) require_sweep_folder(dir, *sweep);
+    if (!a.report_only) require_sweep_folder(dir, x, *sweep);
     if (a.calibration) calibration = read_calibration(*a.calibration);
+    if (!a.report_only) require_model_files(x, *sweep, a.file);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {  // a model file's model, built to check it
+    std::cerr << "deformlab: error: out of host memory while checking the sweep's model files\n";
     return 2;
   }
   return report_errors([&] {
@@ -65,7 +70,7 @@ int experiment_command(const ExperimentArgs& a) {
         }
       }
       std::cout << "deformlab experiment " << x.name << ": " << cells(*sweep).size() << " cells into "
-                << dir.string() << " (cells already there are kept)\n";
+                << dir.string() << " (cells already there are kept, but for those of another scene or method)\n";
       SweepOptions o;
       o.calibration = calibration;
       o.max_size = a.max_size;
@@ -77,7 +82,8 @@ int experiment_command(const ExperimentArgs& a) {
           std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step"
                     << (p.kept ? " (kept)" : p.remeasured ? " (measured again: the scene or the sweep's method changed)" : "");
         else
-          std::cout << ": n/a (" << r["reason"].get<std::string>() << ")";
+          std::cout << ": n/a (" << r["reason"].get<std::string>() << ")"
+                    << (p.remeasured ? " (measured again: the scene or the sweep's method changed)" : "");
         std::cout << "  [" << duration_text(p.elapsed_s);
         // The time left at the rate of the cells run so far: none to go by while only kept cells came.
         if (p.done < p.total && ran > 0)

@@ -47,8 +47,6 @@ struct Ran {
   ClockSummary clock;  // the GPU's clock over the run, on pipelines with a GPU pass
 };
 
-// Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
-// renders into the staged frames/ folder.
 // When a convergence run's stop rule starts, in words.
 std::string stop_rule_start(const Params& p) {
   const std::string why = p.drag.active() ? " (min_steps and the drag path's end at t = " +
@@ -59,6 +57,8 @@ std::string stop_rule_start(const Params& p) {
                                                   : "the stop rule starts at step " + std::to_string(step) + why;
 }
 
+// Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
+// renders into the staged frames/ folder.
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {
   // Untimed steps from rest for --warmup-ms (by default kGpuWarmUpMs where a pass runs on a GPU).
   const double warm_ms = a.warmup_ms.value_or(on_gpu(*in.entry) ? kGpuWarmUpMs : 0.0);

@@ -404,11 +404,11 @@ void apply_json(Scene& s, const json& j, const std::string& where, const std::st
   if (j.contains("threshold")) p.threshold = num(j["threshold"], where + ".threshold", Range::positive);
   if (j.contains("min_steps")) p.min_steps = integer(j["min_steps"], where + ".min_steps", 0);
   if (j.contains("max_steps")) p.max_steps = integer(j["max_steps"], where + ".max_steps", 1);
-  // A min_steps this object does not give follows a max_steps below it; one it gives cannot.
-  if (j.contains("min_steps") && p.min_steps > p.max_steps)
+  // An object that gives both cannot give them the wrong way round; a max_steps alone below the
+  // min_steps a scene takes leaves a convergence run no step to stop at, which the run says.
+  if (j.contains("min_steps") && j.contains("max_steps") && p.min_steps > p.max_steps)
     bad(where + ".min_steps",
         "min_steps (" + std::to_string(p.min_steps) + ") exceeds max_steps (" + std::to_string(p.max_steps) + ")");
-  p.min_steps = std::min(p.min_steps, p.max_steps);
   if (j.contains("check_every")) p.check_every = integer(j["check_every"], where + ".check_every", 1);
   if (j.contains("runaway_factor"))
     p.runaway_factor = num(j["runaway_factor"], where + ".runaway_factor", Range::positive);

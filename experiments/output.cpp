@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "build_info.hpp"
+#include "core/frame_files.hpp"
 #include "core/write_error.hpp"
 
 namespace deformlab {
@@ -54,8 +55,7 @@ std::string foreign_frames_entry(const fs::path& frames) {
   if (!fs::is_directory(frames, ec)) return "";
   for (const auto& e : fs::directory_iterator(frames, ec)) {
     const std::string name = e.path().filename().string();
-    const bool frame = name.starts_with("frame_") && name.ends_with(".png") && e.is_regular_file(ec);
-    if (!frame && !(name == "frames.mp4" && e.is_regular_file(ec))) return name;
+    if (!is_frames_file(name) || !e.is_regular_file(ec)) return name;
   }
   return "";
 }

@@ -12,6 +12,7 @@
 #include "paper.hpp"
 #include "plot.hpp"
 #include "report_parts.hpp"
+#include "sweep_folder.hpp"
 
 namespace deformlab {
 
@@ -269,7 +270,7 @@ void write_table(Report& r, const Table& t) {
     write_ratio_cells(r, t, rats, n);
     r.md << "\n";
   }
-  const std::string svg = "plot-" + t.title + ".svg";
+  const std::string svg = plot_file(t.title);
   std::erase_if(series, [](const plot::Series& s) { return s.x.empty(); });  // no cell measured: no legend entry
   const bool paper = std::any_of(series.begin(), series.end(), [](const plot::Series& s) { return s.dashed; });
   const std::string y = std::string("ms per step, each on its pipeline's step clock") +
@@ -322,7 +323,13 @@ Sweep sweep_of(const fs::path& dir, const json& manifest) {
 
 fs::path write_report(const fs::path& dir) {
   const json manifest = read_manifest(dir);
-  Report r{.dir = dir, .manifest = manifest, .sweep = sweep_of(dir, manifest), .cells = load_cells(dir)};
+  const Sweep sweep = sweep_of(dir, manifest);
+  std::vector<json> cells = load_cells(dir);
+  // Cells of another scene or method than the manifest's (a run stopped, or under --max-size,
+  // before it measured them again) are not this experiment's results yet.
+  if (manifest.contains("measurement"))
+    std::erase_if(cells, [&](const json& c) { return !measured_as(c, manifest["measurement"], sweep); });
+  Report r{.dir = dir, .manifest = manifest, .sweep = sweep, .cells = std::move(cells)};
   r.name = manifest["experiment"].value("name", std::string("experiment"));
   r.by_pipeline = r.sweep.paper_table == "table3";
   r.ceil = ceilings_of(manifest.value("calibration", json()));
@@ -336,8 +343,8 @@ fs::path write_report(const fs::path& dir) {
   write_frames(r);
   r.notes.write(r.md);
   write_reading(r);
-  write_atomically(dir / "report.md", r.md.str());
-  return dir / "report.md";
+  write_atomically(dir / kReportFile, r.md.str());
+  return dir / kReportFile;
 }
 
 }  // namespace deformlab

@@ -5,6 +5,7 @@
 #include "core/profiler.hpp"
 #include "pipelines.hpp"
 #include "plot.hpp"
+#include "report.hpp"
 #include "report_parts.hpp"
 
 namespace deformlab::report {
@@ -157,7 +158,7 @@ void write_stage_group(std::ostringstream& md, const fs::path& dir, const std::s
   }
   std::vector<std::string> parts = g.gpu_stages;
   parts.push_back("rest");
-  std::string file = "stages-" + g.label + ".svg";
+  std::string file = stages_file(g.label);
   for (char& ch : file)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '.') ch = '_';
   plot::stacked_bars(dir / file, name + ": " + g.label, "% of the timed step (stages profiled apart)", parts, bars);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <chrono>
 #include <fstream>
-#include <set>
 
 #include "core/run.hpp"
 #include "core/scene.hpp"
@@ -15,6 +14,7 @@
 #include "mesh/scene_model.hpp"
 #include "output.hpp"
 #include "pipelines.hpp"
+#include "sweep_folder.hpp"
 #include "sweep_models.hpp"
 #if DEFORMLAB_HAVE_GL
 #include "gl/context.hpp"
@@ -217,17 +217,12 @@ void write_atomically(const fs::path& file, const std::string& text) {
   fs::rename(tmp, file);
 }
 
-namespace {
-
-// A cell file's result, or null when the file is not a cell result (damaged, edited).
 json read_cell(const fs::path& file) {
   std::ifstream in(file);
   json j = json::parse(in, nullptr, false);
   if (j.is_discarded() || !j.is_object() || !j.contains("status") || !j.contains("id")) return nullptr;
   return j;
 }
-
-}  // namespace
 
 std::vector<json> load_cells(const fs::path& dir) {
   std::vector<json> out;
@@ -257,41 +252,6 @@ void require_same_experiment(const fs::path& dir, const std::string& name) {
                                 "', not '" + name + "': give this one another --out");
 }
 
-void require_sweep_folder(const fs::path& dir, const Sweep& s) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return;
-  auto refuse = [&](const std::string& entry, const std::string& why) {
-    throw std::invalid_argument("results folder '" + dir.string() + "' holds '" + entry + "', " + why +
-                                ": move it or give another --out");
-  };
-  if (folder_holds(dir) == Holds::nothing) {
-    for (const auto& e : fs::directory_iterator(dir, ec)) {
-      const std::string name = e.path().filename().string();
-      const bool svg = name.ends_with(".svg") && (name.starts_with("plot-") || name.starts_with("stages-"));
-      if (svg || name == "report.md" || name == "frames" || name == "manifest.json")
-        refuse(name, "which no experiment wrote there");
-    }
-    return;
-  }
-  std::set<std::string> ids;
-  for (const auto& c : cells(s)) ids.insert(c.id() + ".json");
-  for (const auto& f : fs::directory_iterator(dir / "cells", ec)) {
-    const std::string name = f.path().filename().string();
-    if (f.path().extension() == ".json" && !ids.count(name) && read_cell(f.path()).is_null())
-      refuse("cells/" + name, "which is not a cell result");
-  }
-  if (const std::string e = foreign_frames_entry(dir / "frames"); !e.empty()) refuse("frames/" + e, "which no run writes there");
-}
-
-json measurement(const json& raw) {
-  json m = raw;
-  for (const char* k : {"name", "description", "integrator", "sweep"}) m.erase(k);
-  if (raw.contains("sweep") && raw["sweep"].is_object())
-    for (const auto& [k, v] : raw["sweep"].items())
-      if (k == "warmup" || k == "steps" || k == "repetitions" || k == "cell_limit_s" || k == "time") m["sweep"][k] = v;
-  return m;
-}
-
 int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
   using clock = std::chrono::steady_clock;
   require_same_experiment(dir, x.name);
@@ -299,21 +259,18 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   reclaim_temporaries(dir);
   reclaim_temporaries(dir / "cells");
   json manifest = {{"experiment", x.raw}, {"command", command}, {"build", build_info()}, {"machine", machine_info()}};
-  // Cells from before "measurement" was recorded were measured as the folder's manifest says.
   const json old = read_manifest(dir);
-  const json method = measurement(x.raw);
-  const bool had = old.is_object() && old.contains("experiment") && old["experiment"].is_object();
-  const json old_method = had ? measurement(old["experiment"]) : json();
+  record_earlier_measurements(dir, old, x, s);
+  const json method = measurement(x, s);
+  manifest["measurement"] = method;
+  manifest["frames_of"] = frames_measurement(x, s);
   // The calibration given, else the one an earlier run of this folder recorded; the frames
-  // an earlier run rendered of the same scene.
+  // an earlier run rendered of this scene.
   manifest["calibration"] = o.calibration;
-  if (old.is_object()) {
-    if (old.contains("calibration") && o.calibration.is_null()) manifest["calibration"] = old["calibration"];
-    const bool same_scene = had && old_method == method && old["experiment"].value("integrator", json()) == x.raw.value("integrator", json());
-    if (old.contains("frames") && fs::exists(dir / "frames") && same_scene) manifest["frames"] = old["frames"];
-  }
-  // Frames that no manifest records come from a run killed in between, or show another scene:
-  // render them again.
+  if (old.is_object() && old.contains("calibration") && o.calibration.is_null()) manifest["calibration"] = old["calibration"];
+  if (frames_kept(dir, old, x, s)) manifest["frames"] = old["frames"];
+  // Frames that no manifest records come from a run killed in between, or show another scene
+  // (require_sweep_folder has seen that they hold nothing else): render them again.
   if (!manifest.contains("frames")) fs::remove_all(dir / "frames");
   json devices = json::object();
   for (const auto& p : s.pipelines)
@@ -331,14 +288,15 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     const fs::path file = dir / "cells" / (c.id() + ".json");
     // A measured cell is done; an n/a one is tried again (the build or machine may differ).
     json r = fs::exists(file) ? read_cell(file) : json();  // a damaged cell file is redone
-    const bool measured = r.is_object() && r["status"] == "ok";
-    prog.kept = measured && r.value("measurement", old_method) == method;
-    prog.remeasured = measured && !prog.kept;
+    const json as = cell_measurement(method, s, c.model);
+    const bool earlier = r.is_object() && r.value("measurement", json()) != as;  // of another scene or method
+    prog.kept = r.is_object() && r["status"] == "ok" && !earlier;
+    prog.remeasured = earlier;
     if (prog.kept) {
       ++prog.skipped;
     } else {
       r = run_cell(x, s, c, cache);
-      r["measurement"] = method;
+      r["measurement"] = as;
       write_atomically(file, r.dump(2) + "\n");
       ++ran;
     }

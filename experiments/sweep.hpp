@@ -56,7 +56,7 @@ struct SweepProgress {
   int done = 0, total = 0, skipped = 0;
   double elapsed_s = 0;
   bool kept = false;  // this cell was measured before and kept, not run
-  bool remeasured = false;  // this cell was measured before, with another scene or method
+  bool remeasured = false;  // this cell was measured before, with another scene or method, and ran again
 };
 
 struct SweepOptions {
@@ -70,7 +70,7 @@ struct SweepOptions {
 };
 
 // Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again, and so are
-// cells measured with another scene or sweep method: measurement()) and returns the number
+// cells measured with another scene or sweep method: sweep_folder.hpp) and returns the number
 // it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first;
 // then, unless `dir`/frames/ exists, renders the sweep's frames there (render_frames) and
 // records them, or why there are none (for now, under `o.max_size`), as the manifest's "frames".
@@ -111,15 +111,8 @@ std::vector<nlohmann::json> load_cells(const std::filesystem::path& dir);
 
 // Throws std::invalid_argument when `dir` holds the results of another experiment than `name`.
 void require_same_experiment(const std::filesystem::path& dir, const std::string& name);
-// Throws std::invalid_argument, before sweep `s` runs into `dir`, where it would write over or
-// remove what no experiment wrote: in a folder that holds no experiment's results, a report,
-// plot, frames/ or cells/ of its own; in one that does, a file in cells/ that is neither a
-// cell result nor named as one of the sweep's cells, or an entry of frames/ that no run writes.
-void require_sweep_folder(const std::filesystem::path& dir, const Sweep& s);
-// What a cell's measurement depends on beyond the cell itself: the experiment (its JSON, `raw`)
-// less its name, description, integrator and the sweep's lists of cells and frames, which
-// only choose cells. Recorded in each cell as "measurement".
-nlohmann::json measurement(const nlohmann::json& raw);
+// A cell file's result, or null when the file is not a cell result (damaged, edited).
+nlohmann::json read_cell(const std::filesystem::path& file);
 
 // Writes `text` to `file` through a temporary file and a rename.
 void write_atomically(const std::filesystem::path& file, const std::string& text);

@@ -55,16 +55,17 @@ std::vector<std::string> parse_sweep_orders(const json& j, const std::string& wh
 
 void require_model_files(const Experiment& x, const Sweep& s, const std::string& where) {
   for (std::size_t k = 0; k < s.models.size(); ++k) {
-    const std::string w = where + ".sweep.models[" + std::to_string(k) + "].model";
+    const std::string at = where + ".sweep.models[" + std::to_string(k) + "]", w = at + ".model";
     Scene scene = x.scene;
     scene.model.topology = Topology::general;
-    apply_json(scene, {{"model", s.models[k].model}}, w, x.dir);
+    apply_json(scene, {{"model", s.models[k].model}}, at, x.dir);
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
     try {
-      check_mesh_file(scene.model);
+      check_mesh_file(scene);
     } catch (const std::invalid_argument& e) {
+      if (std::string(e.what()).starts_with(w)) throw;  // a key's error (pins) names its path
       bad(w, e.what());
     }
   }

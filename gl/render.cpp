@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "core/frame_files.hpp"
 #include "core/write_error.hpp"
 #include "gl_pipeline.hpp"
 
@@ -480,10 +481,8 @@ FrameWriter::FrameWriter(const Model& m, std::filesystem::path dir, int every, R
 }
 
 void FrameWriter::write(Pipeline& p, int step) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.png", step);
   r_.draw(p);
-  r_.write_png(dir_ / name);
+  r_.write_png(dir_ / frame_file(step));
   const auto ms = r_.take_draw_ms();
   draw_ms_.insert(draw_ms_.end(), ms.begin(), ms.end());
   last_written_ = step;
@@ -497,9 +496,9 @@ void FrameWriter::after_step(Pipeline& p, int step) {
 void FrameWriter::finish(Pipeline& p, int last_step) {
   if (last_written_ != last_step) write(p, last_step);
   if (frames_ < 2 || std::system("command -v ffmpeg >/dev/null 2>&1") != 0) return;
-  const std::string cmd = "ffmpeg -loglevel error -y -framerate 30 -pattern_type glob -i '" + dir_.string() +
-                          "/frame_*.png' -c:v libx264 -pix_fmt yuv420p '" + dir_.string() + "/frames.mp4'";
-  if (std::system(cmd.c_str()) == 0) movie_ = "frames.mp4";
+  const std::string cmd = "ffmpeg -loglevel error -y -framerate 30 -pattern_type glob -i '" + dir_.string() + "/" +
+                          kFrameGlob + "' -c:v libx264 -pix_fmt yuv420p '" + dir_.string() + "/" + kFramesMovie + "'";
+  if (std::system(cmd.c_str()) == 0) movie_ = kFramesMovie;
 }
 
 nlohmann::json FrameWriter::manifest() const {

@@ -91,22 +91,30 @@ void check_fill_size(const Mesh& surface, float cell_size) {
   }
 }
 
-// The mesh a spec's model is made of: read or generated, placed by its scale and transform,
-// repaired and, with "fill", filled with tetrahedra (the filled mesh also written to `fill_to`
-// when given); `what` names it in errors.
-Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string& what,
-                const std::string& fill_to = {}) {
+// The mesh a spec names, read or generated, placed by its scale and transform and repaired;
+// with "fill", checked to be a surface whose filling fits, not yet filled. `what` names it in
+// errors.
+Mesh prepared_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string& what) {
   Mesh mesh = source_mesh(ms, what, notes);
   return naming(what, [&] {
     place(mesh, ms);
     for (auto& line : repair(mesh)) notes.push_back(std::move(line));
-    if (ms.fill) {
-      if (mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
-      if (ms.cell_size > 0) check_fill_size(mesh, ms.cell_size);
-      mesh = fill_tetrahedra(mesh, ms.cell_size, fill_to);
-      for (auto& line : repair(mesh)) notes.push_back("after filling: " + line);
-    }
+    if (ms.fill && mesh.volume()) throw std::invalid_argument("it is a volume already: leave out \"fill\"");
+    if (ms.fill && ms.cell_size > 0) check_fill_size(mesh, ms.cell_size);
     return std::move(mesh);
+  });
+}
+
+// The mesh a spec's model is made of: prepared_mesh, with "fill" filled with tetrahedra (the
+// filled mesh also written to `fill_to` when given).
+Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string& what,
+                const std::string& fill_to = {}) {
+  Mesh mesh = prepared_mesh(ms, notes, what);
+  if (!ms.fill) return mesh;
+  return naming(what, [&] {
+    Mesh filled = fill_tetrahedra(mesh, ms.cell_size, fill_to);
+    for (auto& line : repair(filled)) notes.push_back("after filling: " + line);
+    return filled;
   });
 }
 
@@ -138,18 +146,16 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
   return generate_shape(shape, save_to);
 }
 
-void check_mesh_file(const ModelSpec& spec) {
-  const MeshSpec& ms = spec.mesh;
-  if (ms.generate || ms.file.empty()) return;
-  std::vector<std::string> notes;
-  std::string what;
-  Mesh mesh = source_mesh(ms, what, notes);
-  naming(what, [&] {
-    place(mesh, ms);
-    repair(mesh);
-    if (!ms.fill) check_memory(mesh);
-    return ms.fill ? Model{} : mesh_model(mesh, spec.material, ms.density);  // its springs: a non-manifold edge
-  });
+void check_mesh_file(const Scene& s) {
+  const MeshSpec& ms = s.model.mesh;
+  if (s.model.topology != Topology::general || ms.generate || ms.file.empty()) return;
+  if (ms.fill) {
+    std::vector<std::string> notes;
+    std::string what;
+    prepared_mesh(ms, notes, what);
+  } else {
+    build_model_in_file_order(s);  // its springs (a non-manifold edge) and its pins
+  }
 }
 
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to) {

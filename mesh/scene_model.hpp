@@ -23,10 +23,11 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to = {});
 // the same mesh.
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
 
-// Reads, places and repairs the mesh of a model that names a file and, unless it is to be
-// filled, makes its springs, so that a damaged file is refused before a sweep's first cell;
-// throws std::invalid_argument naming it.
-void check_mesh_file(const ModelSpec& spec);
+// For a scene whose model names a mesh file: reads, places and repairs it and, unless it is to
+// be filled, builds the model with its pins (a model to be filled: checked up to its fill), so
+// that a damaged file is refused before a sweep's first cell; throws std::invalid_argument
+// naming it.
+void check_mesh_file(const Scene& s);
 
 // build_model in two parts, for callers that keep one mesh in several orders: the model with
 // its pins in the file's order (a generated mesh: Gmsh's), then the scene's node order.

@@ -3,7 +3,9 @@
 #include <climits>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <stdexcept>
+#include <string>
 
 #include "core/json_file.hpp"
 #include "core/write_error.hpp"
@@ -11,26 +13,38 @@
 namespace deformlab::viewer {
 namespace {
 
-const std::pair<const char*, Event::Kind> kKinds[] = {
-    {"press", Event::Kind::press}, {"move", Event::Kind::move},   {"release", Event::Kind::release},
-    {"scroll", Event::Kind::scroll}, {"key", Event::Kind::key},   {"set", Event::Kind::set},
-    {"screenshot", Event::Kind::screenshot}, {"quit", Event::Kind::quit},
+// Each kind of event with the keys it takes besides "frame" and "event".
+struct KindKeys {
+  const char* name;
+  Event::Kind kind;
+  std::set<std::string> keys;
+};
+const KindKeys kKinds[] = {
+    {"press", Event::Kind::press, {"x", "y", "button", "shift"}},
+    {"move", Event::Kind::move, {"x", "y"}},
+    {"release", Event::Kind::release, {}},
+    {"scroll", Event::Kind::scroll, {"x", "y"}},
+    {"key", Event::Kind::key, {"key"}},
+    {"set", Event::Kind::set, {"pipeline", "integrator", "dt", "options"}},
+    {"screenshot", Event::Kind::screenshot, {"file"}},
+    {"quit", Event::Kind::quit, {}},
 };
 
 const char* kind_name(Event::Kind k) {
-  for (const auto& [name, kind] : kKinds)
-    if (kind == k) return name;
+  for (const auto& e : kKinds)
+    if (e.kind == k) return e.name;
   return "?";
 }
 
 Event from_json(const nlohmann::json& j) {
   if (!j.is_object()) throw std::invalid_argument("an event must be an object");
   Event e;
-  const std::string kind = j.value("event", "");
-  bool known = false;
-  for (const auto& [name, k] : kKinds)
-    if (kind == name) e.kind = k, known = true;
-  if (!known) throw std::invalid_argument("unknown event '" + kind + "'");
+  const std::string kind = j.contains("event") && j["event"].is_string() ? j["event"].get<std::string>() : "";
+  const KindKeys* of = nullptr;
+  for (const auto& k : kKinds)
+    if (kind == k.name) of = &k;
+  if (!of) throw std::invalid_argument("unknown event '" + kind + "'");
+  e.kind = of->kind;
   auto text = [](const nlohmann::json& v, const std::string& key) {
     if (!v.is_string()) throw std::invalid_argument(key + " must be a string");
     return v.get<std::string>();
@@ -41,6 +55,8 @@ Event from_json(const nlohmann::json& j) {
   };
   for (const auto& [key, v] : j.items()) {
     if (key == "event") continue;
+    if (key != "frame" && !of->keys.count(key))
+      throw std::invalid_argument("unknown key '" + key + "' of a " + kind + " event");
     if (key == "frame") {
       if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > INT_MAX)
         throw std::invalid_argument("frame must be a whole number >= 0");
@@ -56,12 +72,15 @@ Event from_json(const nlohmann::json& j) {
       const bool letter = e.key.size() == 1 && e.key[0] >= 'a' && e.key[0] <= 'z';
       if (!letter && e.key != "space" && e.key != "backspace")
         throw std::invalid_argument("key '" + e.key + "' is not a key name (a-z, space, backspace)");
-    } else if (key == "file") e.file = text(v, key);
-    else if (e.kind == Event::Kind::set && (key == "pipeline" || key == "integrator" || key == "dt" || key == "options"))
-      e.settings[key] = v.is_string() ? v.get<std::string>() : v.dump();
-    else
-      throw std::invalid_argument("unknown key '" + key + "'");
+    } else if (key == "file") {
+      e.file = text(v, key);
+    } else if (key == "dt" && v.is_number()) {  // set
+      e.settings[key] = v.dump();
+    } else {
+      e.settings[key] = text(v, key);
+    }
   }
+  if (e.kind == Event::Kind::key && e.key.empty()) throw std::invalid_argument("a key event needs a key");
   if (e.kind == Event::Kind::press && e.button != "left" && e.button != "right" && e.button != "middle")
     throw std::invalid_argument("button must be left, right or middle");
   if (e.kind == Event::Kind::screenshot && e.file.empty()) throw std::invalid_argument("a screenshot needs a file");

@@ -37,7 +37,10 @@ nlohmann::json to_json(Vec3f v) { return {v.x, v.y, v.z}; }
 // SIGINT or SIGTERM asks the loop to end as the window's close button does, so that the
 // recording, the script and the summary are still written.
 volatile std::sig_atomic_t g_signal = 0;
-void on_signal(int sig) { g_signal = sig; }
+void on_signal(int sig) {
+  g_signal = sig;
+  std::signal(sig, SIG_DFL);  // a second one ends the process at once
+}
 
 class Viewer {
  public:
@@ -63,7 +66,7 @@ class Viewer {
       draw();
       for (const std::string& file : std::exchange(shots_, {})) screenshot(file);
       if (rec_ && (rec_->width() != w_.width() || rec_->height() != w_.height())) stop_recording();
-      if (rec_) rec_->add(window_pixels());
+      if (rec_) add_to_recording();
       w_.swap();
       ++frame_;
       if ((o_.frames > 0 && frame_ >= o_.frames) || (video_frames > 0 && frame_ >= video_frames)) quit_ = true;
@@ -176,6 +179,17 @@ class Viewer {
     r->finish();
     summary_["recordings"].push_back({{"file", r->file()}, {"frames", r->frames()}, {"fps", kVideoFps}});
     message_ = "recorded " + r->file() + " (" + std::to_string(r->frames()) + " frames)";
+  }
+
+  // A recording whose ffmpeg has gone ends with the message why; the session goes on.
+  void add_to_recording() {
+    try {
+      rec_->add(window_pixels());
+    } catch (const std::runtime_error& e) {
+      message_ = e.what();
+      std::cerr << "deformlab: note: " << one_line(e.what()) << "; the recording ends\n";
+      rec_.reset();
+    }
   }
 
   // Key v: a recording into deformlab-view-<frame>.mp4 starts, or the one running ends.
@@ -444,13 +458,17 @@ class Viewer {
 }  // namespace
 
 int run(Window& w, Session& s, const ViewOptions& o) {
-  struct Handlers {  // on_signal while the loop runs
-    Handlers() : sigint(std::signal(SIGINT, on_signal)), sigterm(std::signal(SIGTERM, on_signal)) { g_signal = 0; }
-    ~Handlers() {
-      std::signal(SIGINT, sigint);
-      std::signal(SIGTERM, sigterm);
+  struct Handlers {  // on_signal while the loop runs, but for a signal the process ignores (nohup)
+    Handlers() {
+      g_signal = 0;
+      for (int k = 0; k < 2; ++k)
+        if ((old[k] = std::signal(kSignals[k], on_signal)) == SIG_IGN) std::signal(kSignals[k], SIG_IGN);
     }
-    void (*sigint)(int), (*sigterm)(int);
+    ~Handlers() {
+      for (int k = 0; k < 2; ++k) std::signal(kSignals[k], old[k]);
+    }
+    const int kSignals[2] = {SIGINT, SIGTERM};
+    void (*old[2])(int) = {};
   } handlers;
   return Viewer(w, s, o).loop();
 }

@@ -62,7 +62,8 @@ RoundingBound rounding_bound(const State& a, const State& r, Bound floor, double
 // into a velocity by 1/dt (Verlet's v is a position difference over dt).
 Bound ulp_floor(const State& s, float dt);
 // `g` within `b` of `a`: positions and velocities, each by its largest node distance and its
-// root mean square, and previous positions by their largest; the message gives each.
+// root mean square, and previous positions by their largest; the message gives each. Fails
+// where a bound is not finite (a NaN or infinity in the states it came from).
 testing::AssertionResult within_rounding(const State& g, const State& a, const RoundingBound& b);
 
 // Equal bit for bit (positions, velocities, previous positions, time).

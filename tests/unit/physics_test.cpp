@@ -205,6 +205,7 @@ EnergyRun energy_run(Integrator integ, int steps) {
 // drift; bounded here by w dt); explicit Euler multiplies a mode's energy by 1 + (w dt)^2 a
 // step, so the total grows, by at most (1 + (w dt)^2)^N; a Runge-Kutta scheme of order p moves
 // it by its local error, at most N (w dt)^(p+1) over N steps; backward Euler only loses it.
+// (That bound does not tell the orders apart: the ConvergenceOrder tests measure them.)
 TEST(Energy, EachSchemeWithinWhatItDoesToTheFastestMode) {
   const int n = 10000;
   for (const auto& i : integrators()) {

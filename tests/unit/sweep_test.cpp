@@ -13,6 +13,7 @@
 #include "experiments/report.hpp"
 #include "experiments/report_parts.hpp"
 #include "experiments/sweep.hpp"
+#include "experiments/sweep_folder.hpp"
 
 namespace deformlab {
 namespace {
@@ -107,35 +108,60 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
 }
 
 // A folder resumed with another scene or sweep method measures its cells again; the name, the
-// description and the sweep's lists of cells do not change how a cell is measured.
+// description and the sweep's lists of cells do not change how a cell is measured. Cells of
+// another scene that a run has not measured again are not in its report.
 TEST_F(SweepTest, CellsOfAnotherSceneOrMethodAreMeasuredAgain) {
-  const auto sweep = R"({"sizes": [4], "pipelines": ["cpu", "omp"], "warmup": 1, "steps": 2, "repetitions": 2})";
-  const Experiment x = tiny(sweep);
+  auto experiment = [](const std::string& scene, const std::string& sweep, const std::string& more = "") {
+    return parse_experiment(R"({"name": "tiny", "base": "paper-drag", "integrator": "midpoint", "scene": )" + scene +
+                                R"(, "sweep": )" + sweep + more + "}",
+                            "tiny.json");
+  };
+  const std::string scene = R"({"model": {"size": [4, 4]}})", slow_scene = R"({"model": {"size": [4, 4]}, "dt": 1e-4})";
+  const std::string sweep = R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})";
+  const Experiment x = experiment(scene, sweep);
   const Sweep s = *parse_sweep(x.raw, "tiny");
-  ASSERT_EQ(run_sweep(x, s, dir_, {}, json::array()), 2);
-  for (const auto& r : load_cells(dir_)) EXPECT_EQ(r["measurement"], measurement(x.raw)) << r.dump();
-  Experiment described = x;
-  described.raw["description"] = "the same cells";
-  described.raw["sweep"]["sizes"] = {4, 5};
-  EXPECT_EQ(run_sweep(described, *parse_sweep(described.raw, "tiny"), dir_, {}, json::array()), 2) << "only size 5";
-  Experiment slower = x;
-  slower.raw["scene"]["dt"] = 1e-4;
+  auto run = [&](const Experiment& e, SweepOptions o = {}) { return run_sweep(e, *parse_sweep(e.raw, "tiny"), dir_, o, json::array()); };
+  ASSERT_EQ(run(x), 2);
+  for (const auto& r : load_cells(dir_)) EXPECT_EQ(r["measurement"], cell_measurement(measurement(x, s), s, "")) << r.dump();
+  EXPECT_EQ(run(experiment(scene, sweep, R"(, "description": "the same cells")")), 0);
+  EXPECT_EQ(run(experiment(scene, R"({"sizes": [4, 5, 6], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})")), 1);
   int remeasured = 0;
   SweepOptions o;
   o.on_cell = [&](const Cell&, const json&, const SweepProgress& p) { remeasured += p.remeasured; };
-  EXPECT_EQ(run_sweep(slower, s, dir_, o, json::array()), 2);
+  const Experiment slower = experiment(slow_scene, sweep);
+  EXPECT_EQ(run(slower, o), 2);
   EXPECT_EQ(remeasured, 2);
-  Experiment longer = slower;
-  longer.raw["sweep"]["steps"] = 3;
-  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 2);
-  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 0);
-  // Cells from before "measurement" was recorded count as measured as the manifest says.
-  const fs::path cell = dir_ / "cells" / (Cell{4, "cpu", "midpoint", {}}.id() + ".json");
-  json r = json::parse(slurp(cell));
-  r.erase("measurement");
-  std::ofstream(cell) << r.dump();
-  EXPECT_EQ(run_sweep(longer, s, dir_, {}, json::array()), 0);
-  EXPECT_EQ(run_sweep(x, s, dir_, {}, json::array()), 2);
+  const Experiment longer = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 3, "repetitions": 2})");
+  EXPECT_EQ(run(longer), 2);
+  EXPECT_EQ(run(longer), 0);
+  // A run stopped before it measured a cell again (here by --max-size) leaves that cell out of
+  // its report; so does the next run.
+  SweepOptions small;
+  small.max_size = 4;
+  const Experiment quicker = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})");
+  Sweep up_to_4 = *parse_sweep(quicker.raw, "tiny");
+  up_to_4.sizes = {4};  // as `experiment --max-size 4` leaves it
+  EXPECT_EQ(run_sweep(quicker, up_to_4, dir_, small, json::array()), 1);
+  const std::string report = slurp(write_report(dir_));
+  EXPECT_NE(report.find("Not measured yet: 5²"), std::string::npos) << report;
+  // Cells from before "measurement" was recorded count as measured as their manifest's
+  // experiment, where that is this one; after another, they are measured again.
+  for (const auto& f : fs::directory_iterator(dir_ / "cells")) {
+    json r = json::parse(slurp(f.path()));
+    r.erase("measurement");
+    std::ofstream(f.path()) << r.dump();
+  }
+  json manifest = json::parse(slurp(dir_ / "manifest.json"));
+  manifest.erase("measurement");
+  manifest.erase("frames_of");
+  std::ofstream(dir_ / "manifest.json") << manifest.dump();
+  EXPECT_EQ(run_sweep(quicker, up_to_4, dir_, small, json::array()), 0);
+  for (const auto& f : fs::directory_iterator(dir_ / "cells")) {
+    json r = json::parse(slurp(f.path()));
+    r.erase("measurement");
+    std::ofstream(f.path()) << r.dump();
+  }
+  EXPECT_EQ(run(x), 2) << "the folder's manifest holds another experiment than x";
 }
 
 // A sweep refuses, before it runs, a folder where it would write over or remove what no
@@ -145,7 +171,7 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
   const Sweep s = *parse_sweep(x.raw, "tiny");
   auto refusal = [&] {
     try {
-      require_sweep_folder(dir_, s);
+      require_sweep_folder(dir_, x, s);
     } catch (const std::invalid_argument& e) {
       return std::string(e.what());
     }
@@ -169,11 +195,31 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
   std::ofstream(dir_ / "cells" / "notes.json") << "mine";
   EXPECT_NE(refusal().find("holds 'cells/notes.json', which is not a cell result"), std::string::npos);
   fs::remove(dir_ / "cells" / "notes.json");
+  // Frames of this scene are kept, with whatever else is in their folder; frames of another are
+  // removed, so another's file among them is refused.
   fs::create_directories(dir_ / "frames");
   std::ofstream(dir_ / "frames" / "frame_000001.png") << "a frame";
-  EXPECT_EQ(refusal(), "");
   std::ofstream(dir_ / "frames" / "own.txt") << "mine";
-  EXPECT_NE(refusal().find("holds 'frames/own.txt', which no run writes there"), std::string::npos);
+  json manifest = json::parse(slurp(dir_ / "manifest.json"));
+  manifest["frames"] = {{"files", {"frames/frame_000001.png"}}};
+  std::ofstream(dir_ / "manifest.json") << manifest.dump();
+  EXPECT_EQ(refusal(), "");
+  const Experiment other = parse_experiment(
+      R"({"name": "tiny", "base": "paper-drag", "integrator": "midpoint", "scene": {"model": {"size": [4, 4]}, "dt": 1e-4},
+          "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})",
+      "tiny.json");
+  try {
+    require_sweep_folder(dir_, other, s);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("holds 'frames/own.txt', which no run writes there"), std::string::npos) << e.what();
+  }
+  // A folder whose manifest names no experiment is not one's results, cells/ or not.
+  fs::remove_all(dir_);
+  fs::create_directories(dir_ / "cells");
+  std::ofstream(dir_ / "cells" / "data.csv") << "mine";
+  std::ofstream(dir_ / "manifest.json") << R"({"mine": 1})";
+  EXPECT_NE(refusal().find("holds 'manifest.json', which no experiment wrote there"), std::string::npos);
 }
 
 // Under --max-size the experiment's own grid, if larger, leaves its frames for a later run, as

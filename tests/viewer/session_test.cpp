@@ -131,6 +131,10 @@ TEST(ViewerScript, MistypedEventsAreRefusedByIndex) {
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "move", "x": "left"})"), at + "x must be a number");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "press", "shift": 1})"), at + "shift must be true or false");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "screenshot", "file": 3})"), at + "file must be a string");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key"})"), at + "a key event needs a key");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "quit", "button": "left"})"), at + "unknown key 'button' of a quit event");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "pipeline": 3})"), at + "pipeline must be a string");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": 0.001, "options": "math=fast"})"), "");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "w"})"), "");
   const std::vector<viewer::Event> events = viewer::read_script(file.string());
   viewer::write_script(file.string(), events);

@@ -205,13 +205,19 @@ TEST_F(View, RefusesBadInputWithOneLine) {
   }
 }
 
-// SIGINT ends a session as closing its window does: its summary is written, exit 0.
-TEST_F(View, SigintEndsTheSessionWithItsFiles) {
-  const Result r = run_wrapped("xvfb-run -a -s '-screen 0 1600x1000x24' timeout --preserve-status -s INT 8 ",
-                               "view --scene " + scene_.string() + " --summary " + (dir_ / "summary.json").string());
+// SIGTERM (as SIGINT, which a background job ignores) ends a session as closing its window
+// does: its recording and summary are written, exit 0.
+TEST_F(View, SigtermEndsTheSessionWithItsFiles) {
+  if (!have("ffmpeg")) GTEST_SKIP() << "ffmpeg is not installed";
+  const fs::path movie = dir_ / "session.mp4";
+  const Result r = run_wrapped("xvfb-run -a -s '-screen 0 1600x1000x24' timeout --preserve-status -s TERM 8 ",
+                               "view --scene " + scene_.string() + " --size 320x240 --record " + movie.string() +
+                                   " --summary " + (dir_ / "summary.json").string());
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("deformlab: note: SIGINT at frame "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("deformlab: note: SIGTERM at frame "), std::string::npos) << r.err;
   EXPECT_GT(summary()["frames"].get<int>(), 0);
+  ASSERT_EQ(summary()["recordings"].size(), 1u) << summary().dump();
+  EXPECT_GT(fs::file_size(movie), 0u);
 }
 
 // With no display: stderr of `deformlab view ARGS`, which must exit 2 with one line.
