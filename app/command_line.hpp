@@ -5,9 +5,12 @@
 // and inf pass to the options' own range checks, which name what the option takes.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <iomanip>
 #include <iostream>
 #include <charconv>
+#include <cstdlib>
 #include <limits>
+#include <sstream>
 #include <string>
 
 #include "core/one_line.hpp"
@@ -32,6 +35,29 @@ inline std::string decimal_problem(const std::string& v, bool whole) {
   return "";
 }
 
+// A number option's range check, after the decimal check (CLI::Range would call a word out of
+// range): whole numbers from `lo` to `hi`, or reals (NaN is in no range).
+inline CLI::Validator whole_in(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& v) {
+        if (std::string problem = decimal_problem(v, true); !problem.empty()) return problem;
+        const long long n = std::stoll(v);
+        return n < lo || n > hi ? "'" + v + "' is not in " + std::to_string(lo) + " to " + std::to_string(hi) : std::string();
+      },
+      "");
+}
+inline CLI::Validator real_in(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& v) {
+        if (std::string problem = decimal_problem(v, false); !problem.empty()) return problem;
+        const double d = std::strtod(v.c_str(), nullptr);  // an overflow is infinite: out of range
+        std::ostringstream range;
+        range << std::setprecision(15) << lo << " to " << hi;
+        return !(d >= lo && d <= hi) ? "'" + v + "' is not in " + range.str() : std::string();
+      },
+      "");
+}
+
 // Checks every whole-number and real option of `app`'s subcommands (and their vectors' items).
 inline void decimal_numbers_only(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands({}))
@@ -43,9 +69,22 @@ inline void decimal_numbers_only(CLI::App& app) {
     }
 }
 
-// Parses `argv` into `cli`: help is printed (0); a parse error is one line on stderr that
-// names the help of the command it was in, "program command --help" (2). Else -1.
+// Parses `argv` into `cli`: help is printed (0); an unknown command, or a parse error, is one
+// line on stderr, the latter naming the help of the command it was in, "program command --help"
+// (2). Else -1.
 inline int parse_command_line(CLI::App& cli, int argc, char** argv) {
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : cli.get_subcommands({})) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << cli.get_name() << ": error: unknown command '" << one_line(argv[1]) << "' (valid: " << names << ")\n";
+      return 2;
+    }
+  }
   try {
     cli.parse(argc, argv);
     return -1;

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
   run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)")
-      ->check(CLI::Range(0, 1023));
+      ->check(deformlab::app::whole_in(0, 1023));
   run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");
   run->add_option("--warmup-ms", a.warmup_ms,
                   "Untimed steps from rest for at least this long before the run, which then starts from rest "
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
       ->required();
   experiment->add_option("--out,-o", ex.out, "Results folder (default: runs/<experiment name>)");
   experiment->add_option("--max-size", ex.max_size, "Leave out grid sizes above this for now (cells resume later)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(deformlab::app::whole_in(1, 1 << 20));
   experiment->add_flag("--report-only", ex.report_only, "Only rewrite the report from the results folder");
   experiment->add_option("--calibration", ex.calibration,
                          "Calibration JSON (from `deformlab calibrate --out`) to record in the manifest and show "
@@ -108,22 +108,9 @@ int main(int argc, char** argv) {
   mesh->add_option("--out,-o", mesh_args.out, "The .msh file to write")->required();
 
   deformlab::app::decimal_numbers_only(cli);
-  if (argc > 1 && argv[1][0] != '-') {
-    const std::string command = argv[1];
-    std::string names;
-    bool known = false;
-    for (const CLI::App* sub : cli.get_subcommands({})) {
-      known = known || sub->get_name() == command;
-      names += (names.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (command == "help") {
-      std::cout << cli.help();
-      return 0;
-    }
-    if (!known) {
-      std::cerr << "deformlab: error: unknown command '" << command << "' (valid: " << names << ")\n";
-      return 2;
-    }
+  if (argc > 1 && std::string(argv[1]) == "help") {
+    std::cout << cli.help();
+    return 0;
   }
   if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   if (*run) return deformlab::app::run_command(a);

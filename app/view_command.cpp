@@ -19,6 +19,7 @@ namespace {
 void require_file_target(const std::string& file, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
+  if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
   const fs::path folder = fs::path(file).parent_path();
   if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
   if (!folder.empty() && !fs::is_directory(folder, ec))
@@ -36,19 +37,27 @@ int view_command(const ViewArgs& a) {
     const std::vector<int> size = parse_size(a.size, 2, "--size");
     check_run_flags(a.run);
     if (size[0] > 16384 || size[1] > 16384) throw std::invalid_argument("--size: at most 16384x16384");
+    // Each file the session reads or writes is one flag's (or one screenshot's).
     std::set<std::string> files;
+    auto own = [&](const std::string& file, const std::string& what) {
+      if (!files.insert(std::filesystem::absolute(file).lexically_normal().string()).second)
+        throw std::invalid_argument(what + " '" + file + "' is a file another flag names too");
+    };
+    if (a.script) own(*a.script, "--script");
     for (const auto& [flag, file] : {std::pair{"--summary", a.summary}, {"--save-script", a.save_script}, {"--record", a.record}}) {
       if (!file) continue;
       require_file_target(*file, flag);
-      if (!files.insert(std::filesystem::absolute(*file).lexically_normal().string()).second)
-        throw std::invalid_argument(std::string(flag) + " '" + *file + "' is a file another flag writes too");
+      own(*file, flag);
     }
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;
     o.steps_per_frame = a.steps_per_frame;
     if (a.script) o.script = viewer::read_script(*a.script);
     for (const viewer::Event& e : o.script)
-      if (e.kind == viewer::Event::Kind::screenshot) require_file_target(e.file, "script " + *a.script + ": screenshot");
+      if (e.kind == viewer::Event::Kind::screenshot) {
+        require_file_target(e.file, "script " + *a.script + ": screenshot");
+        own(e.file, "script " + *a.script + ": screenshot");
+      }
     o.save_script = a.save_script.value_or("");
     o.record = a.record.value_or("");
     o.seconds = a.seconds.value_or(0.0);

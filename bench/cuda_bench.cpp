@@ -10,6 +10,7 @@
 #include <memory>
 #include <utility>
 
+#include "app/command_line.hpp"
 #include "bench.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
 
@@ -301,13 +302,13 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--tile-size", o->tile_size, "Grid size of the tile sweep and the fused summary (0: skip)");
   c->add_option("--graph-sizes", o->graph_sizes, "Grid sizes of the graph comparison");
   c->add_option("--copy-mib", o->copy_mib, "Size of the reference device-to-device copy, MiB")
-      ->check(CLI::Range(1, std::numeric_limits<int>::max()));
+      ->check(deformlab::app::whole_in(1, std::numeric_limits<int>::max()));
   c->add_option("--reference-ms", o->reference_ms, "Reference ms per step at 2048^2 to compare cuda-fused with");
   c->add_option("--temporal-sizes", o->temporal_sizes, "Grid sizes of the cuda-temporal table (none or 0: skip)")
       ->expected(0, CLI::detail::expected_max_vector_size)
-      ->check(CLI::Range(0, 1 << 16));
+      ->check(deformlab::app::whole_in(0, 1 << 16));
   c->add_option("--steps-per-launch", o->steps_per_launch, "cuda-temporal's steps per launch to compare")
-      ->check(CLI::Range(1, 8));
+      ->check(deformlab::app::whole_in(1, 8));
   c->add_option("--temporal-tiles", o->temporal_tiles, "cuda-temporal's tiles WxH to compare (default: its own)");
   c->callback([o] {
     std::erase(o->temporal_sizes, 0);  // "--temporal-sizes" alone gives {0}

@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 
+#include "app/command_line.hpp"
 #include "bench.hpp"
 #include "core/profiler.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
@@ -177,7 +178,7 @@ void add_hybrid_bench(CLI::App& app) {
   c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
   c->add_option("--updates", o->updates, "Update passes: tf, compute");
   c->add_option("--steps", o->steps, "Timed steps at the least (more where they take under 200 ms)")
-      ->check(CLI::Range(1, std::numeric_limits<int>::max()));
+      ->check(deformlab::app::whole_in(1, std::numeric_limits<int>::max()));
   c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
   c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
   c->callback([o] { run_hybrid(*o); });

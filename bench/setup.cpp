@@ -7,6 +7,7 @@
 #include <memory>
 #include <sstream>
 
+#include "app/command_line.hpp"
 #include "bench.hpp"
 #include "core/profiler.hpp"
 #include "core/write_error.hpp"
@@ -87,10 +88,10 @@ Integrator BenchOptions::integ() const {
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {
   c.add_option("--sizes", o.sizes, "Grid sizes n (n x n nodes), 2 and up")
-      ->check(CLI::Range(2, 1 << 17));
+      ->check(deformlab::app::whole_in(2, 1 << 17));
   c.add_flag("--idealised", o.idealised,
              "Time the idealised scene (undamped, no contact, no drag) in place of the paper's (table2's)");
-  c.add_option("--warmup", o.warmup, "Warm-up steps (0: none)")->check(CLI::Range(0, std::numeric_limits<int>::max()));
+  c.add_option("--warmup", o.warmup, "Warm-up steps (0: none)")->check(deformlab::app::whole_in(0, std::numeric_limits<int>::max()));
   c.add_option("--integrator", o.integrator, "Integrator")->transform([](std::string name) {
     const auto i = parse_integrator(name);  // the paper's aliases by their names
     return i ? std::string(info(*i).name) : name;
@@ -100,7 +101,7 @@ void add_bench_options(CLI::App& c, BenchOptions& o) {
 
 void add_warmup_ms(CLI::App& c, BenchOptions& o) {
   c.add_option("--warmup-ms", o.warmup_ms, "Untimed steps from rest before each case for this long, ms (0: none)")
-      ->check(CLI::Range(0.0, 3.6e6));
+      ->check(deformlab::app::real_in(0.0, 3.6e6));
 }
 
 std::string warm_up_words(const BenchOptions& o) {
@@ -131,7 +132,7 @@ void add_step_bench(CLI::App& app, const char* name, const char* description, st
   o->reps = reps;
   auto* c = app.add_subcommand(name, description);
   add_bench_options(*c, *o);
-  c->add_option("--reps", o->reps, reps_help)->check(CLI::Range(1, std::numeric_limits<int>::max()));
+  c->add_option("--reps", o->reps, reps_help)->check(deformlab::app::whole_in(1, std::numeric_limits<int>::max()));
   if (device == Device::gpu) add_warmup_ms(*c, *o);
   c->callback([o, run] { run(*o); });
 }

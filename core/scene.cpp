@@ -435,7 +435,7 @@ Params resolve_params(const Scene& s, const Model& m) {
       throw std::invalid_argument(where + ": " + e.what());
     }
     if (m.pinned(node))
-      throw std::invalid_argument(where + ": node " + std::to_string(node) +
+      throw std::invalid_argument(where + ": node " + std::to_string(m.file_index(node)) +
                                   " is pinned (model.pins), so the drag would not move it");
     p.drag.node = node;
     if (s.drag.offsets)

@@ -40,8 +40,11 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       ~Open() { --bases_open; }
     } open;
     Experiment b;
+    std::string base = j["base"].get<std::string>();  // a name, or a file from this file's folder
+    if (base.find_first_of("/.") != std::string::npos && !dir.empty() && std::filesystem::path(base).is_relative())
+      base = (std::filesystem::path(dir) / base).string();
     try {
-      b = load_experiment_by_name(j["base"].get<std::string>());
+      b = load_experiment_by_name(base);
     } catch (const std::invalid_argument& e) {  // named here only where no file of the chain names it
       const std::string what = e.what();
       throw std::invalid_argument(what.starts_with("no experiment file or built-in") ? where + ".base: " + what : what);

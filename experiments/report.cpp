@@ -326,9 +326,15 @@ fs::path write_report(const fs::path& dir) {
   const Sweep sweep = sweep_of(dir, manifest);
   std::vector<json> cells = load_cells(dir);
   // Cells of another scene or method than the manifest's (a run stopped, or under --max-size,
-  // before it measured them again) are not this experiment's results yet.
-  if (manifest.contains("measurement"))
-    std::erase_if(cells, [&](const json& c) { return !measured_as(c, manifest["measurement"], sweep); });
+  // before it measured them again) are not this experiment's results yet, and cells its sweep
+  // no longer has are not its results at all.
+  std::set<std::string> ids;
+  for (const Cell& c : deformlab::cells(sweep)) ids.insert(c.id());
+  std::erase_if(cells, [&](const json& c) {
+    const Cell of{c.value("size", 0), c.value("pipeline", std::string()), c.value("integrator", std::string()),
+                  c.value("options", PipelineOptions{}), c.value("model", std::string()), c.value("order", std::string())};
+    return !ids.count(of.id()) || (manifest.contains("measurement") && !measured_as(c, manifest["measurement"], sweep));
+  });
   Report r{.dir = dir, .manifest = manifest, .sweep = sweep, .cells = std::move(cells)};
   r.name = manifest["experiment"].value("name", std::string("experiment"));
   r.by_pipeline = r.sweep.paper_table == "table3";

@@ -42,7 +42,11 @@ bool same_experiment_json(const json& old, const Experiment& x) {
 }  // namespace
 
 bool frames_kept(const fs::path& dir, const json& old, const Experiment& x, const Sweep& s) {
-  if (!old.is_object() || !old.contains("frames") || !fs::exists(dir / "frames")) return false;
+  // Frames rendered, not the reason why there were none (a run under --max-size).
+  std::error_code ec;
+  if (!old.is_object() || !old.contains("frames") || !old["frames"].is_object() || !old["frames"].contains("files") ||
+      !fs::is_directory(dir / "frames", ec))
+    return false;
   return old.contains("frames_of") ? old["frames_of"] == frames_measurement(x, s) : same_experiment_json(old, x);
 }
 
@@ -75,12 +79,16 @@ void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep&
       if (is_report_file(name) || name == "frames" || name == "manifest.json")
         refuse(name, "which no experiment wrote there");
     }
+  for (const char* folder : {"cells", "frames"})
+    if (fs::exists(fs::symlink_status(dir / folder, ec)) && !fs::is_directory(fs::symlink_status(dir / folder, ec)))
+      refuse(folder, "where the experiment writes a folder");
   std::set<std::string> ids;
   if (results)
     for (const auto& c : cells(s)) ids.insert(c.id() + ".json");  // a damaged one is measured again
   for (const auto& f : fs::directory_iterator(dir / "cells", ec)) {
     const std::string name = f.path().filename().string();
-    if (f.path().extension() == ".json" && !ids.count(name) && read_cell(f.path()).is_null())
+    if (name.find(".tmp-") != std::string::npos) continue;  // a killed run's, reclaimed by the next
+    if (f.path().extension() != ".json" || (!ids.count(name) && read_cell(f.path()).is_null()))
       refuse("cells/" + name, "which is not a cell result");
   }
   if (frames_kept(dir, old, x, s)) return;

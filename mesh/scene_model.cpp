@@ -154,7 +154,7 @@ void check_mesh_file(const Scene& s) {
     std::string what;
     prepared_mesh(ms, notes, what);
   } else {
-    build_model_in_file_order(s);  // its springs (a non-manifold edge) and its pins
+    resolve_params(s, build_model_in_file_order(s));  // its springs (a non-manifold edge), pins and drag node
   }
 }
 

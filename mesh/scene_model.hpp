@@ -24,7 +24,8 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to = {});
 Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
 
 // For a scene whose model names a mesh file: reads, places and repairs it and, unless it is to
-// be filled, builds the model with its pins (a model to be filled: checked up to its fill), so
+// be filled, builds the model with its pins and finds its drag node (a model to be filled:
+// checked up to its fill), so
 // that a damaged file is refused before a sweep's first cell; throws std::invalid_argument
 // naming it.
 void check_mesh_file(const Scene& s);

@@ -3,6 +3,7 @@
 #include <GL/glew.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -246,20 +247,18 @@ class Viewer {
     PipelineOptions o = s_.options();
     float dt = s_.params().dt;
     std::string bad;
+    if (const auto it = settings.find("pipeline"); it != settings.end()) {  // first: options belong to a pipeline
+      e = pipelines().find(it->second);
+      if (!e) bad = "unknown pipeline '" + it->second + "'";
+      else o.clear();
+    }
     for (const auto& [k, v] : settings) {
-      if (k == "pipeline") {
-        e = pipelines().find(v);
-        if (!e) bad = "unknown pipeline '" + v + "'";
-        else o.clear();  // options belong to a pipeline
-      } else if (k == "integrator") {
+      if (k == "integrator") {
         if (auto p = parse_integrator(v)) i = *p;
         else bad = "unknown integrator '" + v + "'";
       } else if (k == "dt") {
-        try {
-          dt = std::stof(v);
-        } catch (const std::exception&) {
-          bad = "dt '" + v + "' is not a number";
-        }
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), dt);
+        if (ec != std::errc() || end != v.data() + v.size()) bad = "dt '" + v + "' is not a number";
       } else if (k == "options") {
         const auto eq = v.find('=');
         if (eq == std::string::npos) bad = "option '" + v + "': expected NAME=VALUE";

@@ -162,6 +162,17 @@ TEST_F(SweepTest, CellsOfAnotherSceneOrMethodAreMeasuredAgain) {
     std::ofstream(f.path()) << r.dump();
   }
   EXPECT_EQ(run(x), 2) << "the folder's manifest holds another experiment than x";
+  // Cells the sweep no longer has (size 6, from an earlier run) are not in its report.
+  EXPECT_TRUE(fs::exists(dir_ / "cells" / (Cell{6, "cpu", "midpoint", {}}.id() + ".json")));
+  EXPECT_EQ(slurp(write_report(dir_)).find("| 6² |"), std::string::npos);
+}
+
+// A relative base names a file in the experiment file's folder, wherever the command runs.
+TEST_F(SweepTest, ARelativeBaseIsReadFromTheExperimentsFolder) {
+  fs::create_directories(dir_ / "x");
+  std::ofstream(dir_ / "x" / "b.json") << R"({"scene": {"dt": 0.0005}})";
+  std::ofstream(dir_ / "x" / "e.json") << R"({"base": "./b.json", "scene": {"model": {"size": [4, 4]}}})";
+  EXPECT_EQ(load_experiment((dir_ / "x" / "e.json").string()).scene.params.dt, 0.0005f);
 }
 
 // A sweep refuses, before it runs, a folder where it would write over or remove what no
@@ -214,6 +225,16 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("holds 'frames/own.txt', which no run writes there"), std::string::npos) << e.what();
   }
+  // In cells/, any file but a cell result (or a killed run's temporary); a file where the
+  // experiment writes a folder.
+  std::ofstream(dir_ / "cells" / "notes.txt") << "mine";
+  EXPECT_NE(refusal().find("holds 'cells/notes.txt', which is not a cell result"), std::string::npos);
+  fs::remove(dir_ / "cells" / "notes.txt");
+  std::ofstream(dir_ / "cells" / "x.json.tmp-999999999") << "partial";
+  EXPECT_EQ(refusal(), "");
+  fs::remove_all(dir_ / "frames");
+  std::ofstream(dir_ / "frames") << "my notes";
+  EXPECT_NE(refusal().find("holds 'frames', where the experiment writes a folder"), std::string::npos);
   // A folder whose manifest names no experiment is not one's results, cells/ or not.
   fs::remove_all(dir_);
   fs::create_directories(dir_ / "cells");

@@ -192,7 +192,9 @@ TEST_F(View, RefusesBadInputWithOneLine) {
   for (const auto& [args, needle] : std::vector<std::pair<std::string, std::string>>{
            {"--steps-per-frame 0", "--steps-per-frame"},
            {"--summary " + (dir_ / "nodir" / "s.json").string(), "--summary '" + (dir_ / "nodir" / "s.json").string() + "': no folder"},
-           {"--summary " + same + " --save-script " + same, "--save-script '" + same + "' is a file another flag writes too"},
+           {"--summary " + same + " --save-script " + same, "--save-script '" + same + "' is a file another flag names too"},
+           {"--script " + bad.string() + " --summary " + bad.string(), "is a file another flag names too"},
+           {"--summary ''", "--summary: an empty file name"},
            {"--script " + shot.string(), "screenshot 'nodir/x.png': no folder 'nodir'"},
            {"--seconds 2", "--seconds needs --record"},
            {"--size 640", "--size"},
