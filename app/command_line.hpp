@@ -5,10 +5,10 @@
 // and inf pass to the options' own range checks, which name what the option takes.
 #pragma once
 #include <CLI/CLI.hpp>
-#include <iomanip>
-#include <iostream>
 #include <charconv>
 #include <cstdlib>
+#include <iomanip>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -96,8 +96,7 @@ inline int parse_command_line(CLI::App& cli, int argc, char** argv) {
     if (const auto at = what.find(many); at != std::string::npos)
       what = what.substr(0, at) + " is given " + what.substr(at + many.size()) + " times; it takes one value";
     std::string help = cli.get_name();
-    for (const CLI::App* sub : cli.get_subcommands({}))
-      if (argc > 1 && sub->get_name() == argv[1]) help += " " + sub->get_name();
+    if (argc > 1 && argv[1][0] != '-') help.append(" ").append(argv[1]);  // a command (unknown ones are refused above)
     std::cerr << cli.get_name() << ": error: " << what << " (see " << help << " --help)\n";
     return 2;
   }

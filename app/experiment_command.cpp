@@ -1,6 +1,5 @@
 #include <filesystem>
 #include <iostream>
-#include <new>
 
 #include "commands.hpp"
 #include "run_input.hpp"
@@ -42,15 +41,12 @@ int experiment_command(const ExperimentArgs& a) {
     require_same_experiment(dir, x.name);
     if (!a.report_only) require_sweep_folder(dir, x, *sweep);
     if (a.calibration) calibration = read_calibration(*a.calibration);
-    if (!a.report_only) require_model_files(x, *sweep, a.file);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
-  } catch (const std::bad_alloc&) {  // a model file's model, built to check it
-    std::cerr << "deformlab: error: out of host memory while checking the sweep's model files\n";
-    return 2;
   }
   return report_errors([&] {
+    if (!a.report_only) require_model_files(x, *sweep, a.file);  // builds the models: out of memory is bad input
     if (a.report_only && !calibration.is_null()) {
       // Records the calibration given in the folder's manifest; the cells stay as they are.
       nlohmann::json manifest = read_manifest(dir);

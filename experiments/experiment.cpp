@@ -40,11 +40,8 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       ~Open() { --bases_open; }
     } open;
     Experiment b;
-    std::string base = j["base"].get<std::string>();  // a name, or a file from this file's folder
-    if (base.find_first_of("/.") != std::string::npos && !dir.empty() && std::filesystem::path(base).is_relative())
-      base = (std::filesystem::path(dir) / base).string();
     try {
-      b = load_experiment_by_name(base);
+      b = load_experiment_by_name(j["base"].get<std::string>(), dir);
     } catch (const std::invalid_argument& e) {  // named here only where no file of the chain names it
       const std::string what = e.what();
       throw std::invalid_argument(what.starts_with("no experiment file or built-in") ? where + ".base: " + what : what);
@@ -99,8 +96,8 @@ Experiment load_experiment(const std::string& path) {
   return x;
 }
 
-Experiment load_experiment_by_name(const std::string& path_or_name) {
-  if (path_or_name.find('/') == std::string::npos && path_or_name.find('.') == std::string::npos) {
+Experiment load_experiment_by_name(const std::string& path_or_name, const std::string& from) {
+  if (path_or_name.find_first_of("/.") == std::string::npos) {
     if (const auto text = experiment_files::find(path_or_name + ".json"))
       return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_data_dir());
     std::error_code ec;
@@ -108,7 +105,8 @@ Experiment load_experiment_by_name(const std::string& path_or_name) {
       throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name +
                                   "' (built in: " + builtin_experiment_names() + ")");
   }
-  return load_experiment(path_or_name);
+  const std::filesystem::path file(path_or_name);
+  return load_experiment(file.is_relative() && !from.empty() ? (std::filesystem::path(from) / file).string() : path_or_name);
 }
 
 std::string builtin_experiment_names(bool sweeps_only) {

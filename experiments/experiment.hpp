@@ -30,8 +30,9 @@ Experiment load_experiment(const std::string& path);
 // A path to an experiment file, or the name of one built into the binary ("table1"). A
 // built-in experiment's mesh files are taken from the source tree's data/ (builtin_data_dir).
 // A file without a "name" is named by its file name without ".json", where that is a plain name.
-// A name that is neither is bad input naming the built-in ones.
-Experiment load_experiment_by_name(const std::string& path_or_name);
+// A name that is neither is bad input naming the built-in ones. A relative file is taken from
+// folder `from` (an experiment file's, for its "base") where it is given.
+Experiment load_experiment_by_name(const std::string& path_or_name, const std::string& from = "");
 // The names of the experiments built into the binary (experiments/*.json), comma-separated:
 // "gl-memory, interop, ..."; with `sweeps_only`, those with a sweep (`deformlab experiment`'s).
 std::string builtin_experiment_names(bool sweeps_only = false);

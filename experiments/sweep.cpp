@@ -288,15 +288,14 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     const fs::path file = dir / "cells" / (c.id() + ".json");
     // A measured cell is done; an n/a one is tried again (the build or machine may differ).
     json r = fs::exists(file) ? read_cell(file) : json();  // a damaged cell file is redone
-    const json as = cell_measurement(method, s, c.model);
-    const bool earlier = r.is_object() && r.value("measurement", json()) != as;  // of another scene or method
+    const bool earlier = r.is_object() && !measured_as(r, method, s);  // of another scene or method
     prog.kept = r.is_object() && r["status"] == "ok" && !earlier;
     prog.remeasured = earlier;
     if (prog.kept) {
       ++prog.skipped;
     } else {
       r = run_cell(x, s, c, cache);
-      r["measurement"] = as;
+      r["measurement"] = cell_measurement(method, s, c.model);
       write_atomically(file, r.dump(2) + "\n");
       ++ran;
     }

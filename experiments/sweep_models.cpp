@@ -62,12 +62,7 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
-    try {
-      check_mesh_file(scene);
-    } catch (const std::invalid_argument& e) {
-      if (std::string(e.what()).starts_with(w)) throw;  // a key's error (pins) names its path
-      bad(w, e.what());
-    }
+    check_mesh_file(scene);  // its errors name the file, or the key (pins, the drag node)
   }
 }
 

@@ -31,7 +31,8 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
   // own (setsid), so that a terminal's Ctrl-C reaches the viewer, which finishes the recording,
   // and not ffmpeg.
   const bool own_session = std::system("command -v setsid >/dev/null 2>&1") == 0;
-  const std::string cmd = std::string(own_session ? "exec setsid -w " : "exec ") + "ffmpeg -loglevel error -y -f rawvideo -pix_fmt rgba -s " + std::to_string(w_) + "x" +
+  const std::string cmd = std::string(own_session ? "exec setsid -w " : "exec ") +
+                          "ffmpeg -loglevel error -y -f rawvideo -pix_fmt rgba -s " + std::to_string(w_) + "x" +
                           std::to_string(h_) + " -r " + std::to_string(fps) +
                           " -i - -vf 'vflip,crop=trunc(iw/2)*2:trunc(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -f mp4 " +
                           shell_quoted(partial_);

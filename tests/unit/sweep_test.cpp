@@ -146,21 +146,20 @@ TEST_F(SweepTest, CellsOfAnotherSceneOrMethodAreMeasuredAgain) {
   EXPECT_NE(report.find("Not measured yet: 5²"), std::string::npos) << report;
   // Cells from before "measurement" was recorded count as measured as their manifest's
   // experiment, where that is this one; after another, they are measured again.
-  for (const auto& f : fs::directory_iterator(dir_ / "cells")) {
-    json r = json::parse(slurp(f.path()));
-    r.erase("measurement");
-    std::ofstream(f.path()) << r.dump();
-  }
+  auto forget_measurements = [&] {  // as cells written before they recorded one
+    for (const auto& f : fs::directory_iterator(dir_ / "cells")) {
+      json r = json::parse(slurp(f.path()));
+      r.erase("measurement");
+      std::ofstream(f.path()) << r.dump();
+    }
+  };
+  forget_measurements();
   json manifest = json::parse(slurp(dir_ / "manifest.json"));
   manifest.erase("measurement");
   manifest.erase("frames_of");
   std::ofstream(dir_ / "manifest.json") << manifest.dump();
   EXPECT_EQ(run_sweep(quicker, up_to_4, dir_, small, json::array()), 0);
-  for (const auto& f : fs::directory_iterator(dir_ / "cells")) {
-    json r = json::parse(slurp(f.path()));
-    r.erase("measurement");
-    std::ofstream(f.path()) << r.dump();
-  }
+  forget_measurements();
   EXPECT_EQ(run(x), 2) << "the folder's manifest holds another experiment than x";
   // Cells the sweep no longer has (size 6, from an earlier run) are not in its report.
   EXPECT_TRUE(fs::exists(dir_ / "cells" / (Cell{6, "cpu", "midpoint", {}}.id() + ".json")));
