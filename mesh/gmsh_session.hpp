@@ -5,6 +5,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/mesh_model.hpp"
 
@@ -40,8 +41,8 @@ class GmshSession {
 };
 
 // The current Gmsh model's linear tetrahedra or, if it has none, its triangles; `what` names
-// it in errors.
-Mesh read_gmsh_model(const std::string& what);
+// it in errors. With `notes`, a volume's triangles that bound no tetrahedron are counted there.
+Mesh read_gmsh_model(const std::string& what, std::vector<std::string>* notes = nullptr);
 // The current Gmsh model into `path` as binary MSH 4.1, through a partial file beside it that
 // is renamed once Gmsh is done (a failed write leaves an existing file as it was, and throws
 // WriteError); load_mesh reads it back as the same mesh: nodes, their order and the elements.

@@ -7,6 +7,7 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -102,6 +103,33 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   return m;
 }
 
+// How many of `triangles` are no face of a tetrahedron of `m` (a volume).
+std::int64_t triangles_bounding_no_tetrahedron(const Mesh& m, std::vector<std::array<std::int32_t, 3>> triangles) {
+  using Face = std::array<std::int32_t, 3>;
+  struct Hash {
+    std::size_t operator()(const Face& f) const {
+      return std::hash<std::uint64_t>()((std::uint64_t(std::uint32_t(f[0])) << 32 | std::uint32_t(f[1])) ^
+                                        std::uint64_t(std::uint32_t(f[2])) * 0x9e3779b97f4a7c15ull);
+    }
+  };
+  std::unordered_map<Face, std::int64_t, Hash> loose;  // sorted triangle -> how often it is given
+  for (Face& f : triangles) {
+    std::sort(f.begin(), f.end());
+    ++loose[f];
+  }
+  for (std::size_t t = 0; t < m.tetrahedron.size() && !loose.empty(); ++t)
+    for (int skip = 0; skip < 4; ++skip) {
+      Face f;
+      for (int c = 0, o = 0; c < 4; ++c)
+        if (c != skip) f[o++] = m.tetrahedron[t][c];
+      std::sort(f.begin(), f.end());
+      loose.erase(f);
+    }
+  std::int64_t count = 0;
+  for (const auto& [face, times] : loose) count += times;
+  return count;
+}
+
 }  // namespace
 
 void write_gmsh_model(const std::string& path) {
@@ -128,7 +156,7 @@ void write_gmsh_model(const std::string& path) {
   }
 }
 
-Mesh read_gmsh_model(const std::string& what) {
+Mesh read_gmsh_model(const std::string& what, std::vector<std::string>* notes) {
   std::vector<std::size_t> tags;
   std::vector<double> coord, param;
   gmsh::model::mesh::getNodes(tags, coord, param, -1, -1, false, false);
@@ -160,16 +188,26 @@ Mesh read_gmsh_model(const std::string& what) {
     if (it == index.end()) throw std::invalid_argument(what + ": an element refers to node " + std::to_string(tag) + ", which is not in the file");
     return it->second;
   };
+  auto triangles = [&](const std::vector<std::size_t>& node_tags) {
+    std::vector<std::array<std::int32_t, 3>> out(node_tags.size() / 3);
+    for (std::size_t e = 0; e < out.size(); ++e)
+      for (int c = 0; c < 3; ++c) out[e][c] = at(node_tags[3 * e + c]);
+    return out;
+  };
   if (volume) {
     m.tetrahedron.resize(elements.size());
     for (std::size_t e = 0; e < elements.size(); ++e)
       for (int c = 0; c < 4; ++c) m.tetrahedron[e][c] = at(nodes[4 * e + c]);
   } else {
-    m.triangle.resize(elements.size());
-    for (std::size_t e = 0; e < elements.size(); ++e)
-      for (int c = 0; c < 3; ++c) m.triangle[e][c] = at(nodes[3 * e + c]);
+    m.triangle = triangles(nodes);
   }
   if (elements.empty()) throw std::invalid_argument(what + ": no tetrahedra or triangles");
+  if (volume && notes) {
+    std::vector<std::size_t> triangle_tags, triangle_nodes;  // (Gmsh does not shrink vectors it is given)
+    gmsh::model::mesh::getElementsByType(2, triangle_tags, triangle_nodes);
+    if (const std::int64_t n = triangles_bounding_no_tetrahedron(m, triangles(triangle_nodes)))
+      notes->push_back("left out " + std::to_string(n) + " triangles that bound no tetrahedron");
+  }
   return m;
 }
 
@@ -189,7 +227,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
     Mesh m;
     GmshSession::run(what, [&] {
       gmsh::open(path);
-      m = read_gmsh_model(what);
+      m = read_gmsh_model(what, &read_notes);
     });
     return m;
   }, notes);

@@ -140,12 +140,39 @@ TEST_F(MeshFile, GmshVolumesAreRead) {
   write_gmsh_box(msh, false);
   Mesh m = load(msh);
   ASSERT_TRUE(m.volume());
+  EXPECT_TRUE(notes_.empty()) << notes_.front();  // the box's boundary triangles are its tetrahedra's faces
   EXPECT_TRUE(repair(m).empty());
   const Model model = mesh_model(m, Material{}, 1000.f);
   double mass = 0;
   for (float w : model.inv_mass) mass += 1.0 / w;
   EXPECT_NEAR(mass, 1000.0 * 0.3 * 0.2 * 0.1, 1e-3);
   EXPECT_GT(std::count(model.kind.begin(), model.kind.end(), SpringKind::flexion), 0);
+}
+
+// A volume with a sheet beside it: the sheet's triangles, which bound no tetrahedron, are left
+// out and counted (its nodes are then unreferenced, and repair drops them).
+TEST_F(MeshFile, AVolumesTrianglesThatBoundNoTetrahedronAreCounted) {
+  const std::string msh = (dir_ / "box-and-sheet.msh").string();
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("box-and-sheet");
+  gmsh::model::occ::addBox(0, 0, 0, 0.3, 0.2, 0.1);
+  const int sheet = gmsh::model::occ::addRectangle(0, 0, 0.5, 0.3, 0.2);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.05);
+  gmsh::model::mesh::generate(3);
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> tags, nodes;
+  gmsh::model::mesh::getElements(types, tags, nodes, 2, sheet);
+  ASSERT_EQ(types, std::vector<int>{2});
+  const std::size_t sheet_triangles = tags[0].size();
+  gmsh::write(msh);
+  gmsh::finalize();
+  Mesh m = load(msh);
+  ASSERT_TRUE(m.volume());
+  EXPECT_GT(sheet_triangles, 10u);
+  EXPECT_EQ(notes_, std::vector<std::string>{"left out " + std::to_string(sheet_triangles) +
+                                             " triangles that bound no tetrahedron"});
 }
 
 // Gmsh and assimp trust a file's counts: a damaged one could crash them or take all memory.
