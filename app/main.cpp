@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   calibrate->add_option("--out,-o", cal.out, "JSON file to write (default: standard output)");
 
   deformlab::app::MeshArgs mesh_args;
-  auto* mesh = cli.add_subcommand("mesh", "Write the mesh a scene generates (its model's \"generate\") to a Gmsh .msh file");
+  auto* mesh = cli.add_subcommand("mesh", "Write the mesh a scene generates or fills (its model's \"generate\" or \"fill\") to a Gmsh .msh file");
   mesh->add_option("--experiment", mesh_args.experiment, "Experiment file or built-in name (default: paper-drag)");
   mesh->add_option("--scene", mesh_args.scene, "Scene file in place of the experiment's scene (absent keys: the defaults)");
   mesh->add_option("--model", mesh_args.model, "One of the mesh models the experiment's sweep names");
