@@ -14,12 +14,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A pass over JSON text that finds a key given twice in one object (the library keeps the
-// last) and where that object is ("spheres[1]"): the keys of each object still open, and where
-// each open container sits in its parent.
-class DuplicateKey : public nlohmann::json_sax<nlohmann::json> {
+// A pass over JSON text, before the library builds its tree, that finds
+// - a key given twice in one object (the library keeps the last) and where that object is
+//   ("spheres[1]"): the keys of each object still open, and where each open container sits in
+//   its parent;
+// - arrays and objects nested deeper than kMaxDepth, which the library's tree would copy and
+//   free by recursion, as deep as the nesting (a stack overflow at 100 000 levels).
+class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
  public:
-  std::string found;  // "'key' twice in one object (at path)", or empty
+  static constexpr std::size_t kMaxDepth = 256;
+  std::string found;  // "gives the key 'key' twice in one object (at path)", or empty
 
   bool null() override { return value(); }
   bool boolean(bool) override { return value(); }
@@ -47,7 +51,7 @@ class DuplicateKey : public nlohmann::json_sax<nlohmann::json> {
       if (!at.empty()) at += '.';
       at += open_[i].key;
     }
-    found = "'" + k + "' twice in one object" + (at.empty() ? "" : " (at " + at + ")");
+    found = "gives the key '" + k + "' twice in one object" + (at.empty() ? "" : " (at " + at + ")");
     return false;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
@@ -66,7 +70,9 @@ class DuplicateKey : public nlohmann::json_sax<nlohmann::json> {
   bool open(bool object) {
     value();
     open_.push_back({object});
-    return true;
+    if (open_.size() <= kMaxDepth) return true;
+    found = "nests arrays and objects more than " + std::to_string(kMaxDepth) + " deep";
+    return false;
   }
   bool close() {
     open_.pop_back();
@@ -78,6 +84,9 @@ class DuplicateKey : public nlohmann::json_sax<nlohmann::json> {
 }  // namespace
 
 nlohmann::json parse_json(const std::string& text, const std::string& source) {
+  JsonCheck check;
+  nlohmann::json::sax_parse(text, &check);
+  if (!check.found.empty()) throw std::invalid_argument(source + " " + check.found);
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
@@ -88,9 +97,6 @@ nlohmann::json parse_json(const std::string& text, const std::string& source) {
       why.erase(0, end + 2);
     throw std::invalid_argument(source + " is not valid JSON: " + why);
   }
-  DuplicateKey twice;
-  nlohmann::json::sax_parse(text, &twice);
-  if (!twice.found.empty()) throw std::invalid_argument(source + " gives the key " + twice.found);
   return j;
 }
 

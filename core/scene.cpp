@@ -188,9 +188,11 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
 
 // "generate": {"shape": "sheet", "size": [w, d], "cell_size": h} or {"shape": "box", "size":
 // [w, h, d], ...}, optionally "threads": n; refused before meshing where it would make more
-// than 2^30 nodes. Lengths lie within [1e-6, 1e6] m: outside that Gmsh's tolerances (relative
-// to the model's size) fail or spin.
-constexpr double kShortestLength = 1e-6, kLongestLength = 1e6;  // m
+// than 2^30 nodes. Lengths lie within [1e-6, 1e6] m, and a shape's sizes within a factor of
+// 1e6 of each other: outside that Gmsh's tolerances (relative to the model's size) fail or
+// spin, or it merges the points of a side much shorter than the others (1e-6 m beside 1000 m
+// ended the process from within Gmsh's threads).
+constexpr double kShortestLength = 1e-6, kLongestLength = 1e6, kLongestRatio = 1e6;  // m, m, 1
 float length(const json& j, const std::string& where) {
   const float v = num(j, where, Range::positive);
   if (v < float(kShortestLength) || v > float(kLongestLength)) bad(where, "expected a length within [1e-6, 1e6] m");
@@ -213,6 +215,11 @@ MeshShape shape(const json& j, const std::string& where) {
     const float v = length(z[k], where + ".size[" + std::to_string(k) + "]");
     s.size[sheet && k == 1 ? 2 : int(k)] = v;
   }
+  const auto [shortest, longest] = std::minmax_element(z.begin(), z.end(), [](const json& a, const json& b) {
+    return a.get<double>() < b.get<double>();
+  });
+  if (longest->get<double>() > kLongestRatio * shortest->get<double>())
+    bad(where + ".size", "its longest side is more than 1e6 times its shortest (Gmsh would merge the shortest's ends)");
   s.cell_size = length(j["cell_size"], where + ".cell_size");
 
   if (j.contains("threads")) {

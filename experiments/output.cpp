@@ -314,6 +314,9 @@ nlohmann::json build_info() {
 
 ModelSize model_size(const ModelSpec& ms) {
   if (ms.topology == Topology::general) throw std::invalid_argument("a mesh's size is known once its file is read");
+  // In double first: a lattice's count can pass what 64 bits hold.
+  if (const double n = double(ms.nx) * ms.ny * ms.nz; n > double(std::int64_t(1) << 30))
+    throw std::invalid_argument("a model of " + about_nodes(n) + " exceeds the limit of 2^30 nodes");
   const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
                                                   : cloth_spring_counts(ms.nx, ms.ny);
   return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2], true};

@@ -1,5 +1,6 @@
 #include "load.hpp"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -49,9 +50,27 @@ void require_ply_header_end(const std::string& path) {
     bad(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
 
+// assimp also opens the files a mesh names (an OBJ's mtllib, a glTF's buffers): regular files
+// only, so that a FIFO or a device named there cannot block the read.
+// (Its Exists opens the file too.)
+class RegularFilesOnly : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* file) const override { return regular(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    return regular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+  }
+
+ private:
+  static bool regular(const char* file) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(file, ec);
+  }
+};
+
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
   require_ply_header_end(path);
   Assimp::Importer importer;
+  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
   // Positions only, so that joining identical vertices looks at positions alone.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS |

@@ -96,6 +96,11 @@ const std::vector<BadInput>& cases() {
       {"unknown_flag", "run --colour red", "--colour"},
       {"grid_too_large", "run --grid 100000x100000", "exceeds the limit of 2^30 nodes"},
       {"lattice_too_large", "run --lattice 2000x2000x2000", "exceeds the limit of 2^30 nodes"},
+      // 2^22 x 2^21 x 2^21 nodes: 2^64, 0 in 64 bits
+      {"lattice_past_64_bits", "run --lattice 4194304x2097152x2097152",
+       "a model of about 1.84e+19 nodes exceeds the limit of 2^30 nodes"},
+      scene("lattice_past_64_bits_in_a_scene", R"({"model": {"type": "lattice", "size": [4194304, 2097152, 2097152]}})",
+            "a model of about 1.84e+19 nodes exceeds the limit of 2^30 nodes"),
       {"host_memory", "run --pipeline reference --grid 32000x32000", "GiB of host memory"},
       {"out_is_a_file", "run --pipeline cpu --steps 3 --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
       {"out_empty", "run --pipeline cpu --steps 3 --out ''", "--out '': an empty path names no folder"},
@@ -116,6 +121,8 @@ const std::vector<BadInput>& cases() {
        "s.json' gives the key 'radius' twice in one object (at spheres[1])",
        {{"s.json", "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}, {\"center\": [0, 1, 0], \"radius\": 1, "
                    "\"radius\": 2}]}"}}},
+      {"scene_nested_deep", "run --scene {dir}/s.json", "s.json' nests arrays and objects more than 256 deep",
+       {{"s.json", "{\"model\": {\"pins\": " + std::string(100000, '[') + std::string(100000, ']') + "}}"}}},
       // scene values
       scene("unknown_key", "{\"dtt\": 1}", "s.json.dtt: unknown key"),
       scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
@@ -238,6 +245,8 @@ const std::vector<BadInput>& cases() {
             "s.json.model.generate.size[0]: expected a length within [1e-6, 1e6] m"),
       scene("generate_box_huge", G(R"({"shape": "box", "size": [3e38, 3e38, 3e38], "cell_size": 1e38})"),
             "s.json.model.generate.size[0]: expected a length within [1e-6, 1e6] m"),
+      scene("generate_sides_far_apart", G(R"({"shape": "sheet", "size": [1000, 1e-6], "cell_size": 1})"),
+            "s.json.model.generate.size: its longest side is more than 1e6 times its shortest"),
       scene("generate_shape", G(R"({"shape": "disc", "size": [1, 1], "cell_size": 0.1})"),
             "s.json.model.generate.shape: expected \"sheet\" or \"box\""),
       scene("generate_sheet_arity", G(R"({"shape": "sheet", "size": [1, 1, 1], "cell_size": 0.1})"),

@@ -7,6 +7,7 @@
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 #include <gmsh.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
@@ -118,6 +119,23 @@ TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
   stl += std::string("\x0c\0\0\0", 4) + std::string(50, '\0');  // 12 triangles announced, one there
   EXPECT_EQ(error("cut.stl", stl).rfind(at + "cut.stl': ", 0), 0u);
   EXPECT_EQ(error("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "accepted");
+}
+
+// Files a mesh names (an OBJ's material library, a glTF's buffer) are opened only where they
+// are regular files: a FIFO there blocked the read for ever.
+TEST_F(MeshFile, FilesAMeshNamesAreOpenedOnlyWhereRegular) {
+  ASSERT_EQ(mkfifo((dir_ / "fifo.bin").c_str(), 0600), 0);
+  EXPECT_EQ(load(write("m.obj", "mtllib fifo.bin\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).triangle.size(), 1u);
+  const std::string gltf = write("m.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "fifo.bin", "byteLength": 36}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}], "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
+    "type": "VEC3", "max": [1, 1, 0], "min": [0, 0, 0]}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  try {
+    load(gltf);
+    ADD_FAILURE() << "read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "mesh file '" + gltf + "': assimp: GLTF: could not open referenced file \"fifo.bin\"");
+  }
 }
 
 // A 0.3 x 0.2 x 0.1 m box meshed by Gmsh and written as .msh (binary where asked).
