@@ -97,16 +97,17 @@ Experiment load_experiment(const std::string& path) {
 }
 
 Experiment load_experiment_by_name(const std::string& path_or_name, const std::string& from) {
+  const std::filesystem::path name(path_or_name);
+  const std::string file = name.is_relative() && !from.empty() ? (std::filesystem::path(from) / name).string() : path_or_name;
   if (path_or_name.find_first_of("/.") == std::string::npos) {
     if (const auto text = experiment_files::find(path_or_name + ".json"))
       return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_data_dir());
     std::error_code ec;
-    if (!std::filesystem::exists(path_or_name, ec))
+    if (!std::filesystem::exists(file, ec))
       throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name +
                                   "' (built in: " + builtin_experiment_names() + ")");
   }
-  const std::filesystem::path file(path_or_name);
-  return load_experiment(file.is_relative() && !from.empty() ? (std::filesystem::path(from) / file).string() : path_or_name);
+  return load_experiment(file);
 }
 
 std::string builtin_experiment_names(bool sweeps_only) {

@@ -172,6 +172,11 @@ TEST_F(SweepTest, ARelativeBaseIsReadFromTheExperimentsFolder) {
   std::ofstream(dir_ / "x" / "b.json") << R"({"scene": {"dt": 0.0005}})";
   std::ofstream(dir_ / "x" / "e.json") << R"({"base": "./b.json", "scene": {"model": {"size": [4, 4]}}})";
   EXPECT_EQ(load_experiment((dir_ / "x" / "e.json").string()).scene.params.dt, 0.0005f);
+  // A name without "." or "/" that is not built in: the file of that name there, not here.
+  std::ofstream(dir_ / "x" / "plainbase") << R"({"scene": {"dt": 0.0004}})";
+  std::ofstream(dir_ / "x" / "p.json") << R"({"base": "plainbase"})";
+  EXPECT_FALSE(fs::exists("plainbase"));
+  EXPECT_EQ(load_experiment((dir_ / "x" / "p.json").string()).scene.params.dt, 0.0004f);
 }
 
 // A sweep refuses, before it runs, a folder where it would write over or remove what no
