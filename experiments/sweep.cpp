@@ -51,6 +51,8 @@ std::vector<std::string> strings(const json& j, const std::string& where) {
   std::vector<std::string> out;
   for (const auto& e : j) {
     if (!e.is_string()) bad(where, "expected a list of names");
+    if (std::find(out.begin(), out.end(), e.get<std::string>()) != out.end())
+      bad(where, "'" + e.get<std::string>() + "' is named twice");
     out.push_back(e.get<std::string>());
   }
   return out;
@@ -73,7 +75,11 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   for (const auto& [k, v] : j.items()) {
     if (k == "sizes") {
       if (!v.is_array() || v.empty()) bad(w + ".sizes", "expected a non-empty list of sizes");
-      for (const auto& n : v) s.sizes.push_back(positive(n, w + ".sizes"));
+      for (const auto& n : v) {
+        s.sizes.push_back(positive(n, w + ".sizes"));
+        if (std::count(s.sizes.begin(), s.sizes.end(), s.sizes.back()) > 1)
+          bad(w + ".sizes", "size " + std::to_string(s.sizes.back()) + " is named twice");
+      }
     } else if (k == "models") s.models = parse_sweep_models(v, w + ".models");
     else if (k == "orders") s.orders = parse_sweep_orders(v, w + ".orders");
     else if (k == "pipelines") s.pipelines = strings(v, w + ".pipelines");
@@ -87,6 +93,8 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
           if (!value.is_string()) bad(w + ".options." + name, "expected a string value");
           po[name] = value.get<std::string>();
         }
+        if (std::find(s.option_sets.begin(), s.option_sets.end(), po) != s.option_sets.end())
+          bad(w + ".options", "an option set is named twice");
         s.option_sets.push_back(po);
       }
     } else if (k == "warmup") s.warmup = positive(v, w + ".warmup");
@@ -150,13 +158,14 @@ std::vector<Cell> cells(const Sweep& s) {
   for (const auto& integ : s.integrators)
     for (const Cell& model : models)
       for (const auto& pipe : s.pipelines) {
-        // A pipeline runs the option sets whose every name it reads; with none, it runs once.
+        // A pipeline runs the option sets whose every name it reads (the empty set among them);
+        // with none, it runs once, with its defaults.
         const auto& accepted = pipelines().find(pipe)->options;
         std::vector<PipelineOptions> sets;
         for (const auto& o : s.option_sets)
           if (std::all_of(o.begin(), o.end(), [&](const auto& kv) {
                 return std::find(accepted.begin(), accepted.end(), kv.first) != accepted.end();
-              }) && (!o.empty() || sets.empty()))
+              }))
             sets.push_back(o);
         if (sets.empty()) sets.push_back({});
         for (const auto& o : sets) out.push_back({model.size, pipe, integ, o, model.model, model.order});

@@ -395,6 +395,14 @@ TEST_F(SweepTest, OptionSetsGoToThePipelinesThatReadThem) {
   EXPECT_TRUE(cs[0].options.empty());
   EXPECT_EQ(cs[1].options.at("tile"), "8x8");
   EXPECT_EQ(cs[2].options.at("tile"), "16x16");
+  // The empty set (defaults) runs on every pipeline, wherever the list has it.
+  for (const char* options : {R"([{"tile": "8x8"}, {}])", R"([{}, {"tile": "8x8"}])"}) {
+    const Experiment y = tiny(R"({"sizes": [4], "pipelines": ["cpu", "cuda-tiled"], "options": )" + std::string(options) + "}");
+    const auto with_defaults = cells(*parse_sweep(y.raw, "tiny"));
+    ASSERT_EQ(with_defaults.size(), 3u) << options;
+    EXPECT_EQ(std::count_if(with_defaults.begin(), with_defaults.end(), [](const Cell& c) { return c.options.empty(); }), 2)
+        << options;
+  }
 }
 
 TEST_F(SweepTest, BadSweepsAreNamed) {
@@ -411,6 +419,16 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "integrators": ["leap"]})").find("unknown integrator"),
             std::string::npos);
   EXPECT_NE(error(R"({"sizes": [0], "pipelines": ["cpu"]})").find("sweep.sizes"), std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4, 8, 4], "pipelines": ["cpu"]})").find("sweep.sizes: size 4 is named twice"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "cpu"]})").find("sweep.pipelines: 'cpu' is named twice"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "integrators": ["verlet", "verlet"]})")
+                .find("sweep.integrators: 'verlet' is named twice"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cuda-tiled"], "options": [{"tile": "8x8"}, {"tile": "8x8"}]})")
+                .find("sweep.options: an option set is named twice"),
+            std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "reps": 3})").find("sweep.reps: unknown key"),
             std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "omp"], "options": [{"tile": "8x8"}]})")
