@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <stdexcept>
 #include <thread>
 
@@ -60,16 +61,19 @@ std::string foreign_frames_entry(const fs::path& frames) {
   return "";
 }
 
-fs::path temporary(const fs::path& name) { return name.string() + ".tmp-" + std::to_string(::getpid()); }
+constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".deformlab-staging-";
+
+fs::path temporary(const fs::path& name) { return name.string().append(kTemporaryTag) + std::to_string(::getpid()); }
+
+bool is_temporary(const std::string& name) { return name.find(kTemporaryTag) != std::string::npos; }
 
 namespace {
 
-// Whether `name` is a temporary ("*.tmp-<pid>", ".staging-<pid>") of this process or of one
-// that is gone.
+// Whether `name` is a temporary or a staging folder of this process or of one that is gone.
 bool reclaimable(const std::string& name) {
-  std::size_t at = name.rfind(".tmp-");
-  std::size_t len = 5;
-  if (name.rfind(".staging-", 0) == 0) at = 0, len = 9;
+  std::size_t at = name.rfind(kTemporaryTag);
+  std::size_t len = kTemporaryTag.size();
+  if (name.starts_with(kStagingTag)) at = 0, len = kStagingTag.size();
   if (at == std::string::npos) return false;
   const std::string digits = name.substr(at + len);
   if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return false;
@@ -85,7 +89,7 @@ void finish_stopped_commit(const fs::path& dir) {
   if (fs::exists(dir / "manifest.json", ec)) return;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (!name.starts_with(".staging-") || !reclaimable(name) || folder_holds(e.path()) != Holds::run) continue;
+    if (!name.starts_with(kStagingTag) || !reclaimable(name) || folder_holds(e.path()) != Holds::run) continue;
     for (const auto& f : fs::directory_iterator(e.path())) {
       if (f.path().filename() == "manifest.json") continue;
       const fs::path target = dir / f.path().filename();
@@ -95,6 +99,13 @@ void finish_stopped_commit(const fs::path& dir) {
     fs::rename(e.path() / "manifest.json", dir / "manifest.json");
     return;
   }
+}
+
+// `dir` as an absolute path without a trailing separator.
+fs::path absolute_folder(const fs::path& dir) {
+  std::error_code ec;
+  fs::path p = fs::absolute(dir, ec).lexically_normal();
+  return p.has_filename() ? p : p.parent_path();
 }
 
 }  // namespace
@@ -144,8 +155,8 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
     : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
-  created_ = !fs::exists(dir_, ec);
-  if (!created_) finish_stopped_commit(dir_);
+  for (fs::path p = absolute_folder(dir_); p.has_relative_path() && !fs::exists(p, ec); p = p.parent_path()) created_ = p;
+  if (created_.empty()) finish_stopped_commit(dir_);
   require_replaceable(outputs_);
   require_replaceable({"manifest.json"});
   // The earlier run's outputs, by its manifest ("files"; one without the list predates it and
@@ -162,7 +173,7 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
   fs::create_directories(dir_, ec);
   if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
   reclaim_temporaries(dir_);
-  staging_ = dir_ / (".staging-" + std::to_string(::getpid()));
+  staging_ = dir_ / (std::string(kStagingTag) + std::to_string(::getpid()));
   fs::create_directory(staging_, ec);
   if (ec) throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
 }
@@ -170,7 +181,8 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
 OutputDir::~OutputDir() {
   std::error_code ec;
   fs::remove_all(staging_, ec);
-  if (created_ && fs::is_empty(dir_, ec)) fs::remove(dir_, ec);
+  if (created_.empty()) return;
+  for (fs::path p = absolute_folder(dir_); fs::is_empty(p, ec) && fs::remove(p, ec) && p != created_;) p = p.parent_path();
 }
 
 void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {

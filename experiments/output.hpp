@@ -36,9 +36,13 @@ void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 // removed or replaced.
 std::string foreign_frames_entry(const std::filesystem::path& frames);
 
-// The temporary name of `name` for this process: "<name>.tmp-<pid>".
+// The temporary name of `name` for this process: "<name>.deformlab-tmp-<pid>". The names of
+// temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other
+// files are never taken for them.
 std::filesystem::path temporary(const std::filesystem::path& name);
-// Removes the temporaries in `dir` ("*.tmp-<pid>", ".staging-<pid>") whose process is gone.
+// Whether `name` is a temporary's.
+bool is_temporary(const std::string& name);
+// Removes the temporaries and staging folders in `dir` whose process is gone.
 void reclaim_temporaries(const std::filesystem::path& dir);
 
 class OutputDir {
@@ -78,7 +82,7 @@ class OutputDir {
   std::filesystem::path dir_, staging_;
   std::vector<std::string> outputs_;
   std::set<std::string> earlier_;  // of `outputs_`, those the folder's earlier run wrote
-  bool created_ = false;
+  std::filesystem::path created_;  // the outermost folder the constructor created, or empty
 };
 
 // Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their

@@ -87,7 +87,7 @@ void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep&
     for (const auto& c : cells(s)) ids.insert(c.id() + ".json");  // a damaged one is measured again
   for (const auto& f : fs::directory_iterator(dir / "cells", ec)) {
     const std::string name = f.path().filename().string();
-    if (name.find(".tmp-") != std::string::npos) continue;  // a killed run's, reclaimed by the next
+    if (is_temporary(name)) continue;  // a killed run's, reclaimed by the next
     if (f.path().extension() != ".json" || (!ids.count(name) && read_cell(f.path()).is_null()))
       refuse("cells/" + name, "which is not a cell result");
   }

@@ -49,7 +49,7 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_LT(m["compare"]["max_position_error_relative_to_extent"].get<double>(), 1e-5);
   EXPECT_TRUE(m["build"].contains("compiler"));
   EXPECT_TRUE(m["machine"].contains("hardware_threads"));
-  EXPECT_FALSE(fs::exists(out / (".staging-" + std::to_string(::getpid()))));
+  EXPECT_FALSE(fs::exists(out / (".deformlab-staging-" + std::to_string(::getpid()))));
 }
 
 // The node count deformlab mesh prints at the start of its second line ("  N nodes, "), or -1.
@@ -277,18 +277,29 @@ TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {
   const fs::path out = dir_ / "kept";
   fs::create_directories(out);
   std::ofstream(out / "notes.txt") << "mine";
+  // Files of the user's named as temporaries are named, of a process long gone.
+  std::ofstream(out / "thesis.tmp-99999999") << "mine";
+  fs::create_directories(out / ".staging-99999999");
   const Result r = run("run --pipeline cpu --integrator explicit-euler --grid 8x8 --dt 0.05 --steps 500 --out " +
                        out.string());
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("diverged at step"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("amplifies undamped spring oscillations at any dt"), std::string::npos) << r.err;
-  std::vector<std::string> left;
-  for (const auto& e : fs::directory_iterator(out)) left.push_back(e.path().filename().string());
-  EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
+  auto left = [&] {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(out)) names.insert(e.path().filename().string());
+    return names;
+  };
+  const std::set<std::string> mine = {".staging-99999999", "notes.txt", "thesis.tmp-99999999"};
+  EXPECT_EQ(left(), mine);
   EXPECT_EQ(slurp(out / "notes.txt"), "mine");
   // A bad input into an existing folder touches nothing either.
   EXPECT_EQ(run("run --grid 0x0 --out " + out.string()).code, 2);
-  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
+  EXPECT_EQ(left(), mine);
+  // Nor does a failed run leave the folders it made for its outputs.
+  EXPECT_EQ(run("run --pipeline cpu --integrator explicit-euler --grid 8x8 --dt 0.05 --steps 500 --out " +
+                (out / "new" / "sub/").string()).code, 1);
+  EXPECT_EQ(left(), mine);
 }
 
 // cuda-temporal holds steps until a launch can take k of them; a check flushes what it holds,

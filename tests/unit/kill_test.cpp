@@ -51,7 +51,7 @@ std::vector<std::string> temporaries(const fs::path& dir) {
   std::vector<std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    if (name.find(".tmp-") != std::string::npos || name.rfind(".staging-", 0) == 0) out.push_back(name);
+    if (name.find(".deformlab-tmp-") != std::string::npos || name.rfind(".deformlab-staging-", 0) == 0) out.push_back(name);
   }
   return out;
 }
@@ -63,7 +63,7 @@ TEST_F(Cli, KilledRunLeavesTheFolderAsItWas) {
   for (int ms : {100, 400, 900}) {
     ASSERT_TRUE(kill_after("run --pipeline cpu --grid 256x256 --steps 1000000 --out " + out.string(), ms));
     auto after = files_of(out);
-    std::erase_if(after, [](const auto& kv) { return kv.first.rfind(".staging-", 0) == 0; });
+    std::erase_if(after, [](const auto& kv) { return kv.first.rfind(".deformlab-staging-", 0) == 0; });
     EXPECT_EQ(after, before) << "killed after " << ms << " ms";
   }
   const Result r = run("run --pipeline cpu --grid 8x6 --steps 12 --out " + out.string());

@@ -89,7 +89,7 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   EXPECT_EQ(folder_holds(dir), Holds::nothing) << "an incomplete folder has no manifest";
   int moved = 0, staging = 0;
   for (const char* f : {"summary.txt", "state.ply"}) moved += read(dir / f) == "new";
-  for (const auto& e : fs::directory_iterator(dir)) staging += e.path().filename().string().starts_with(".staging-");
+  for (const auto& e : fs::directory_iterator(dir)) staging += e.path().filename().string().starts_with(".deformlab-staging-");
   EXPECT_EQ(moved, 1) << "one output moved in before the stop";
   EXPECT_EQ(staging, 1) << "the stopped process's staging folder";
   {
@@ -101,7 +101,7 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   }
   for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "newer") << f;
   for (const auto& e : fs::directory_iterator(dir))
-    EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << "staging left behind";
+    EXPECT_EQ(e.path().filename().string().find(".deformlab-staging-"), std::string::npos) << "staging left behind";
   fs::remove_all(dir);
 }
 

@@ -93,7 +93,7 @@ TEST_F(SweepTest, RunsResumesAndRecordsUnavailableCells) {
   EXPECT_EQ(seen_skipped, 7 - na);
   EXPECT_EQ(seen_kept, 7 - na) << "each kept cell is marked so";
   for (const auto& f : fs::recursive_directory_iterator(dir_))
-    EXPECT_EQ(f.path().string().find(".tmp-"), std::string::npos) << f.path();
+    EXPECT_EQ(f.path().string().find(".deformlab-tmp-"), std::string::npos) << f.path();
   // Frames of the drag for the report: rendered once (kept on resume), or the reason why not.
   std::ifstream in(dir_ / "manifest.json");
   const json manifest = json::parse(in);
@@ -234,7 +234,7 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
   std::ofstream(dir_ / "cells" / "notes.txt") << "mine";
   EXPECT_NE(refusal().find("holds 'cells/notes.txt', which is not a cell result"), std::string::npos);
   fs::remove(dir_ / "cells" / "notes.txt");
-  std::ofstream(dir_ / "cells" / "x.json.tmp-999999999") << "partial";
+  std::ofstream(dir_ / "cells" / "x.json.deformlab-tmp-999999999") << "partial";
   EXPECT_EQ(refusal(), "");
   fs::remove_all(dir_ / "frames");
   std::ofstream(dir_ / "frames") << "my notes";
