@@ -92,7 +92,13 @@ int experiment_command(const ExperimentArgs& a) {
       const int ran = run_sweep(x, *sweep, dir, o, command);
       std::cout << "ran " << ran << " cells, kept " << int(cells(*sweep).size()) - ran << "\n";
     }
-    const std::filesystem::path report = write_report(dir);
+    std::filesystem::path report;
+    try {
+      report = write_report(dir);
+    } catch (const nlohmann::json::exception& e) {  // a cell is checked as it is read: the manifest
+      throw std::invalid_argument("a results file in " + dir.string() + " (its manifest.json or a cell) holds a value of another kind than the report reads (" +
+                                  e.what() + "): a damaged or edited file; run the experiment into another folder");
+    }
     std::cout << "report: " << report.string() << "\n";
     return 0;
   });

@@ -226,10 +226,37 @@ void write_atomically(const fs::path& file, const std::string& text) {
   fs::rename(tmp, file);
 }
 
+namespace {
+
+// Whether a cell's keys hold the kinds of value that cells are written with (a cell edited by
+// hand or damaged is measured again, not read).
+bool cell_well_formed(const json& c) {
+  if (!c.is_object() || !c.contains("status") || !c.contains("id")) return false;
+  using T = json::value_t;
+  auto is = [&](const char* key, std::initializer_list<T> kinds, bool required = false) {
+    if (!c.contains(key)) return !required;
+    return std::any_of(kinds.begin(), kinds.end(), [&](T k) {
+      return c[key].type() == k || (k == T::number_float && c[key].is_number());
+    });
+  };
+  const bool ok = c["status"] == "ok";
+  const auto text = {T::string}, whole = {T::number_unsigned, T::number_integer}, real = {T::number_float};
+  if (!(is("id", text) && is("status", text) && is("pipeline", text, true) && is("integrator", text, true) &&
+        is("model", text) && is("order", text) && is("reason", text) && is("size", whole) && is("nodes", whole) &&
+        is("springs", whole) && is("options", {T::object}, true) && is("measurement", {T::object}) &&
+        is("stages", {T::array}) && is("sm_clock", {T::object, T::null}) && is("stable", {T::boolean}) &&
+        is("median_ms", real, ok) && is("min_ms", real) && is("samples_ms", {T::array})))
+    return false;
+  const json samples = c.value("samples_ms", json::array());
+  return std::all_of(samples.begin(), samples.end(), [](const json& v) { return v.is_number(); });
+}
+
+}  // namespace
+
 json read_cell(const fs::path& file) {
   std::ifstream in(file);
   json j = json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("status") || !j.contains("id")) return nullptr;
+  if (j.is_discarded() || !cell_well_formed(j)) return nullptr;
   return j;
 }
 

@@ -302,6 +302,38 @@ TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {
   EXPECT_EQ(left(), mine);
 }
 
+// A results folder whose files were damaged or edited: a cell whose values are of other kinds
+// is named (and measured again by a run); a manifest so is one line too.
+TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
+  write("x.json", R"({"name": "tiny", "scene": {"model": {"size": [4, 4]}, "drag": null},
+                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+  const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
+  ASSERT_EQ(run(experiment).code, 0);
+  const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__4.json";
+  const nlohmann::json good = nlohmann::json::parse(slurp(cell));
+  nlohmann::json bad = good;
+  bad["median_ms"] = "fast";
+  std::ofstream(cell) << bad.dump();
+  const Result report = run(experiment + " --report-only");
+  EXPECT_EQ(report.code, 2);
+  EXPECT_EQ(report.err, "deformlab: error: cell file " + cell.string() +
+                            " is not a cell result: if it is one of the sweep's cells, running the experiment again "
+                            "redoes it; else remove it\n");
+  const Result again = run(experiment);
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("ran 1 cells, kept 0"), std::string::npos) << again.out;
+  EXPECT_TRUE(nlohmann::json::parse(slurp(cell))["median_ms"].is_number());
+  nlohmann::json manifest = nlohmann::json::parse(slurp(dir_ / "r" / "manifest.json"));
+  manifest["machine"] = nullptr;
+  std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
+  const Result damaged = run(experiment + " --report-only");
+  EXPECT_EQ(damaged.code, 2);
+  EXPECT_EQ(damaged.err.rfind("deformlab: error: a results file in " + (dir_ / "r").string() +
+                                  " (its manifest.json or a cell) holds a value of another kind", 0),
+            0u) << damaged.err;
+  EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
+}
+
 // cuda-temporal holds steps until a launch can take k of them; a check flushes what it holds,
 // so checks at other than multiples of k cut its launches short, which the run notes.
 TEST_F(Cli, TemporalRunNotesChecksThatCutItsLaunches) {
