@@ -303,14 +303,22 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   }
   // A layer gives the spacing or the width (spacing 0: width over the grid's first axis with more
   // than one node), and replaces the other.
-  if (j.contains("spacing")) m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);
+  // Grid lengths within [1e-6, 1e6] m, as a generated mesh's (spacing 0: from the width): past
+  // that the springs' squared lengths overflow float (a width of 3e38 m ran as a divergence).
+  if (j.contains("spacing")) {
+    m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);
+    if (m.spacing > 0) length(j["spacing"], where + ".spacing");
+  }
   if (j.contains("width")) {
     if (m.spacing > 0 && j.contains("spacing"))
       bad(where + ".width", "give spacing or width, not both (each sets the other)");
-    m.width = num(j["width"], where + ".width", Range::positive);
+    m.width = length(j["width"], where + ".width");
     m.spacing = 0;
   }
-  if (j.contains("height")) m.height = num(j["height"], where + ".height");
+  if (j.contains("height")) {
+    m.height = num(j["height"], where + ".height");
+    if (std::abs(m.height) > float(kLongestLength)) bad(where + ".height", "expected a height within [-1e6, 1e6] m");
+  }
   // A mesh's masses come from `density` or `node_mass`: a layer gives one and replaces the other.
   if (j.contains("node_mass")) {
     if (mesh && j.contains("density"))

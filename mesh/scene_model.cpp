@@ -14,19 +14,21 @@ namespace deformlab {
 namespace {
 
 // Scales and transforms a mesh's vertices, refusing one that is not finite as read (before the
-// transform spreads a NaN to its other coordinates) or that they take out of the float range.
+// transform spreads a NaN to its other coordinates) or that lies, as read or placed, farther
+// than kFarthest from the origin, where a spring's squared length can overflow float.
+constexpr float kFarthest = 1e15f;  // m
 void place(Mesh& m, const MeshSpec& s) {
   const auto& t = s.transform;
+  auto far = [](const Vec3f& p) { return std::abs(p.x) > kFarthest || std::abs(p.y) > kFarthest || std::abs(p.z) > kFarthest; };
   for (auto& p : m.position) {
     if (!finite_vertex(p)) throw std::invalid_argument(non_finite_vertex(p));
     const Vec3f from = p, q{p.x * s.scale.x, p.y * s.scale.y, p.z * s.scale.z};
     for (int r = 0; r < 3; ++r) p[r] = t[r * 4] * q.x + t[r * 4 + 1] * q.y + t[r * 4 + 2] * q.z + t[r * 4 + 3];
-    if (!finite_vertex(p)) {
-      std::ostringstream os;
-      os << "its scale and transform take the vertex (" << from.x << ", " << from.y << ", " << from.z
-         << ") out of the float range";
-      throw std::invalid_argument(os.str());
-    }
+    if (finite_vertex(p) && !far(p)) continue;
+    std::ostringstream os;
+    os << (far(from) ? "the vertex (" : "its scale and transform take the vertex (") << from.x << ", " << from.y << ", "
+       << from.z << (far(from) ? ") lies" : ")") << " more than 1e15 m from the origin, where squared lengths overflow float";
+    throw std::invalid_argument(os.str());
   }
 }
 

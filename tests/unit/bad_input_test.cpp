@@ -194,7 +194,17 @@ const std::vector<BadInput>& cases() {
            "$EndNodes\n$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n",
            "m.msh"),
       mesh("mesh_scale_overflow", "{\"file\": \"m.obj\", \"scale\": 1e38}",
-           "m.obj': its scale and transform take the vertex (10, 0, 0) out of the float range", "v 0 0 0\nv 10 0 0\nv 0 1 0\nf 1 2 3\n"),
+           "m.obj': its scale and transform take the vertex (10, 0, 0) more than 1e15 m from the origin, where squared "
+           "lengths overflow float",
+           "v 0 0 0\nv 10 0 0\nv 0 1 0\nf 1 2 3\n"),
+      mesh("mesh_vertex_far", "{\"file\": \"m.obj\"}",
+           "m.obj': the vertex (-3e+38, 0, 0) lies more than 1e15 m from the origin", "v -3e38 0 0\nv 3e38 0 0\nv 0 1 0\nf 1 2 3\n"),
+      scene("grid_width_past_float", "{\"model\": {\"size\": [4, 4], \"width\": 3e38}}",
+            "s.json.model.width: expected a length within [1e-6, 1e6] m"),
+      scene("grid_spacing_past_float", "{\"model\": {\"size\": [4, 4], \"spacing\": 2e38}}",
+            "s.json.model.spacing: expected a length within [1e-6, 1e6] m"),
+      scene("grid_height_far", "{\"model\": {\"size\": [4, 4], \"height\": -1e7}}",
+            "s.json.model.height: expected a height within [-1e6, 1e6] m"),
       mesh("mesh_ply_nan", "{\"file\": \"m.ply\"}", "m.ply': a vertex has a NaN or infinite coordinate",
            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n",
