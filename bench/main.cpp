@@ -1,4 +1,5 @@
 #include <iostream>
+#include <new>
 #include <stdexcept>
 
 #include "app/command_line.hpp"
@@ -25,6 +26,9 @@ int main(int argc, char** argv) {
     if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   } catch (const std::invalid_argument& e) {  // bad input
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {  // a pipeline's allocation: the check before the model counts only it
+    std::cerr << "deformlab-bench: error: out of memory (host or device): the model or its pipeline does not fit this machine\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";

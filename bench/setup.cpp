@@ -46,7 +46,24 @@ Scene scene_of(int n, SceneKind k) {
 
 BenchScene::BenchScene(int n, SceneKind k) : BenchScene(scene_of(n, k)) {}
 
-BenchScene::BenchScene(const Scene& s) : model(build_model(s)), params(resolve_params(s, model)) {}
+namespace {
+
+// The scene, once its model and a state are known to fit beside what the host has left (the
+// pipelines' own memory is not counted: an allocation of theirs that fails is reported as out of
+// memory).
+const Scene& fitting(const Scene& s) {
+  const ModelSize size = model_size(s.model);
+  const std::int64_t need = model_host_bytes(size) + state_host_bytes(size.nodes);
+  if (const auto limit = host_memory_limit(); limit && need > limit->bytes)
+    throw std::invalid_argument("a " + std::to_string(s.model.nx) + " x " + std::to_string(s.model.ny) + " cloth needs " +
+                                gib(need) + " of host memory for its model and state; " + limit->name + " leaves " +
+                                gib(limit->bytes));
+  return s;
+}
+
+}  // namespace
+
+BenchScene::BenchScene(const Scene& s) : model(build_model(fitting(s))), params(resolve_params(s, model)) {}
 
 Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};

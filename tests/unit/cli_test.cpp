@@ -1,6 +1,7 @@
 // The deformlab command end to end: the outputs of a run and what a failed run leaves
 // (bad inputs: bad_input_test.cpp).
 #include <nlohmann/json.hpp>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -332,6 +333,20 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
                                   " (its manifest.json or a cell) holds a value of another kind", 0),
             0u) << damaged.err;
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
+}
+
+// deformlab-bench checks a size against the host's memory before it builds the model. Its
+// largest cloth, 32768 x 32768 (2^30 nodes), needs 52 GiB for that.
+TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  long long kb = 0;
+  while (meminfo >> key >> kb && key != "MemAvailable:") meminfo.ignore(64, '\n');
+  if (kb > 50LL << 20) GTEST_SKIP() << "this host has room for the bench's largest cloth";
+  const Result r = run("cpu --sizes 32768 --reps 1 --warmup 0", DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("deformlab-bench: error: a 32768 x 32768 cloth needs ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(" of host memory for its model and state; "), std::string::npos) << r.err;
 }
 
 // cuda-temporal holds steps until a launch can take k of them; a check flushes what it holds,
