@@ -16,6 +16,7 @@
 #include "core/memory.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
+#include "experiments/sweep.hpp"
 #include "mesh/scene_model.hpp"
 #if DEFORMLAB_GL_RENDER
 #include "gl/context.hpp"
@@ -38,6 +39,7 @@ Experiment read_experiment(const RunArgs& a) {
   if (a.frames || a.gl_device) throw BadInput("--frames and --gl-device need a build with OpenGL");
 #endif
   Experiment x = a.experiment ? load_experiment_by_name(*a.experiment) : default_experiment();
+  if (a.experiment) parse_sweep(x.raw, *a.experiment);  // a run leaves the sweep out, but not unread
   if (a.scene) x.scene = load_scene(*a.scene);
   if (a.pipeline) x.pipeline = *a.pipeline;
   if (a.integrator) x.integrator = *a.integrator;

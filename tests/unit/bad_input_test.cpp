@@ -355,6 +355,8 @@ const std::vector<BadInput>& cases() {
        {{"x.json", R"({"scene": {"model": {"type": "mesh", "file": "m.obj", "pins": "none"}, "drag": null},
                        "sweep": {"sizes": [4], "pipelines": ["cpu"]}})"},
         {"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}}},
+      {"run_experiment_bad_sweep", "run --experiment {dir}/x.json", "x.json.sweep: expected an object",
+       {{"x.json", R"({"sweep": 5})"}}},
       {"experiment_base_nul", "run --experiment {dir}/x.json", "x.json.base: expected an experiment name (without a NUL",
        {{"x.json", R"({"base": "paper-drag\u0000x"})"}}},
       mesh("mesh_file_nul", R"({"file": "m.obj\u0000.txt"})", "s.json.model.file: expected a file name (without a NUL"),
