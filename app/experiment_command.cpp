@@ -96,8 +96,10 @@ int experiment_command(const ExperimentArgs& a) {
     try {
       report = write_report(dir);
     } catch (const nlohmann::json::exception& e) {  // a cell is checked as it is read: the manifest
-      throw std::invalid_argument("a results file in " + dir.string() + " (its manifest.json or a cell) holds a value of another kind than the report reads (" +
-                                  e.what() + "): a damaged or edited file; run the experiment into another folder");
+      std::string why = e.what();
+      if (const auto end = why.find("] "); why.starts_with("[json.exception.") && end != std::string::npos) why.erase(0, end + 2);
+      throw std::invalid_argument(dir.string() + "/manifest.json holds a value of another kind than the report reads (" + why +
+                                  "): a damaged or edited file; run the experiment into another folder");
     }
     std::cout << "report: " << report.string() << "\n";
     return 0;

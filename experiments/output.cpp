@@ -16,6 +16,7 @@
 
 #include "build_info.hpp"
 #include "core/frame_files.hpp"
+#include "core/json_file.hpp"
 #include "core/write_error.hpp"
 
 namespace deformlab {
@@ -32,8 +33,13 @@ void require_folder_or_nothing(const fs::path& dir) {
 json read_manifest(const fs::path& dir) {
   std::ifstream in(dir / "manifest.json");
   if (!in) return nullptr;
-  json j = json::parse(in, nullptr, false);
-  return j.is_discarded() ? json(nullptr) : j;
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return parse_json(text.str(), "manifest.json");  // JSON nested too deep is refused before the tree is built
+  } catch (const std::invalid_argument&) {
+    return nullptr;
+  }
 }
 
 Holds folder_holds(const fs::path& dir) {

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <chrono>
 #include <fstream>
+#include <sstream>
 
+#include "core/json_file.hpp"
 #include "core/run.hpp"
 #include "core/scene.hpp"
 #include "core/state.hpp"
@@ -228,37 +230,66 @@ void write_atomically(const fs::path& file, const std::string& text) {
 
 namespace {
 
-// Whether a cell's keys hold the kinds of value that cells are written with (a cell edited by
-// hand or damaged is measured again, not read).
-bool cell_well_formed(const json& c) {
-  if (!c.is_object() || !c.contains("status") || !c.contains("id")) return false;
+// What keeps a cell's JSON from being one as cells are written ("its \"method\" is missing or
+// not text"), or empty: the report reads these keys as such. A cell edited by hand or damaged
+// is measured again by a run, not read.
+std::string cell_problem(const json& c) {
+  if (!c.is_object() || !c.contains("status") || !c.contains("id")) return "it has no \"status\" and \"id\"";
   using T = json::value_t;
-  auto is = [&](const char* key, std::initializer_list<T> kinds, bool required = false) {
-    if (!c.contains(key)) return !required;
-    return std::any_of(kinds.begin(), kinds.end(), [&](T k) {
-      return c[key].type() == k || (k == T::number_float && c[key].is_number());
-    });
+  const std::initializer_list<T> text = {T::string}, whole = {T::number_unsigned, T::number_integer},
+                                 real = {T::number_float, T::number_unsigned, T::number_integer}, object = {T::object},
+                                 list = {T::array};
+  auto kind = [](const json& v, std::initializer_list<T> kinds) {
+    return std::find(kinds.begin(), kinds.end(), v.type()) != kinds.end();
   };
   const bool ok = c["status"] == "ok";
-  const auto text = {T::string}, whole = {T::number_unsigned, T::number_integer}, real = {T::number_float};
-  if (!(is("id", text) && is("status", text) && is("pipeline", text, true) && is("integrator", text, true) &&
-        is("model", text) && is("order", text) && is("reason", text) && is("size", whole) && is("nodes", whole) &&
-        is("springs", whole) && is("options", {T::object}, true) && is("measurement", {T::object}) &&
-        is("stages", {T::array}) && is("sm_clock", {T::object, T::null}) && is("stable", {T::boolean}) &&
-        is("median_ms", real, ok) && is("min_ms", real) && is("samples_ms", {T::array})))
-    return false;
-  const json samples = c.value("samples_ms", json::array());
-  return std::all_of(samples.begin(), samples.end(), [](const json& v) { return v.is_number(); });
+  struct Key {
+    const char* name;
+    std::initializer_list<T> kinds;
+    bool required;
+  };
+  for (const Key& k : {Key{"id", text, true}, Key{"status", text, true}, Key{"pipeline", text, true},
+                       Key{"integrator", text, true}, Key{"options", object, true}, Key{"model", text, false},
+                       Key{"order", text, false}, Key{"reason", text, false}, Key{"method", text, ok},
+                       Key{"step_clock", text, false}, Key{"build", text, false}, Key{"mesh", text, false},
+                       Key{"size", whole, false}, Key{"nodes", whole, false}, Key{"springs", whole, false},
+                       Key{"bandwidth", whole, false}, Key{"chosen_options", object, false},
+                       Key{"measurement", object, false}, Key{"sm_clock", {T::object, T::null}, false},
+                       Key{"stable", {T::boolean}, false}, Key{"median_ms", real, ok}, Key{"min_ms", real, false},
+                       Key{"samples_ms", list, false}, Key{"stages", list, false}})
+    if (c.contains(k.name) ? !kind(c[k.name], k.kinds) : k.required)
+      return std::string("its \"") + k.name + "\" is " + (c.contains(k.name) ? "of another kind" : "missing");
+  for (const char* k : {"options", "chosen_options"})
+    if (c.contains(k))
+      for (const auto& value : c[k])
+        if (!value.is_string()) return std::string("its \"") + k + "\" holds a value that is not text";
+  for (const json& v : c.contains("samples_ms") ? c["samples_ms"] : json::array())
+    if (!v.is_number()) return "its \"samples_ms\" holds a value that is not a number";
+  for (const json& st : c.contains("stages") ? c["stages"] : json::array())
+    if (!st.is_object() || !st.contains("name") || !st["name"].is_string() || !st.contains("clock") ||
+        !st["clock"].is_string() || !st.contains("median_ms") || !st["median_ms"].is_number() ||
+        (st.contains("per_step") && !st["per_step"].is_number()))
+      return "its \"stages\" hold an entry that is not a stage";
+  return "";
+}
+
+// The cell in `file`, or what keeps it from being one.
+std::pair<json, std::string> parse_cell(const fs::path& file) {
+  std::ifstream in(file);
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    json j = parse_json(text.str(), "it");
+    if (std::string problem = cell_problem(j); !problem.empty()) return {nullptr, problem};
+    return {std::move(j), ""};
+  } catch (const std::invalid_argument& e) {
+    return {nullptr, e.what()};
+  }
 }
 
 }  // namespace
 
-json read_cell(const fs::path& file) {
-  std::ifstream in(file);
-  json j = json::parse(in, nullptr, false);
-  if (j.is_discarded() || !cell_well_formed(j)) return nullptr;
-  return j;
-}
+json read_cell(const fs::path& file) { return parse_cell(file).first; }
 
 std::vector<json> load_cells(const fs::path& dir) {
   std::vector<json> out;
@@ -268,11 +299,11 @@ std::vector<json> load_cells(const fs::path& dir) {
     if (f.path().extension() == ".json") files.push_back(f.path());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
-    json j = read_cell(f);
+    auto [j, problem] = parse_cell(f);
     if (j.is_null())
-      throw std::invalid_argument("cell file " + f.string() +
-                                  " is not a cell result: if it is one of the sweep's cells, running the experiment "
-                                  "again redoes it; else remove it");
+      throw std::invalid_argument("cell file " + f.string() + " is not a cell result (" + problem +
+                                  "): if it is one of the sweep's cells, running the experiment again redoes it; else "
+                                  "remove it");
     out.push_back(std::move(j));
   }
   return out;

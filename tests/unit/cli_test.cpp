@@ -312,14 +312,21 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   ASSERT_EQ(run(experiment).code, 0);
   const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__4.json";
   const nlohmann::json good = nlohmann::json::parse(slurp(cell));
+  // Each key the report reads is checked (a method of another kind, say).
+  nlohmann::json no_method = good;
+  no_method["method"] = 5;
+  std::ofstream(dir_ / "r" / "cells" / "x.json") << no_method.dump();
+  EXPECT_NE(run(experiment + " --report-only").err.find("x.json is not a cell result (its \"method\" is of another kind)"),
+            std::string::npos);
+  fs::remove(dir_ / "r" / "cells" / "x.json");
   nlohmann::json bad = good;
   bad["median_ms"] = "fast";
   std::ofstream(cell) << bad.dump();
   const Result report = run(experiment + " --report-only");
   EXPECT_EQ(report.code, 2);
   EXPECT_EQ(report.err, "deformlab: error: cell file " + cell.string() +
-                            " is not a cell result: if it is one of the sweep's cells, running the experiment again "
-                            "redoes it; else remove it\n");
+                            " is not a cell result (its \"median_ms\" is of another kind): if it is one of the sweep's "
+                            "cells, running the experiment again redoes it; else remove it\n");
   const Result again = run(experiment);
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_NE(again.out.find("ran 1 cells, kept 0"), std::string::npos) << again.out;
@@ -329,8 +336,8 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
   const Result damaged = run(experiment + " --report-only");
   EXPECT_EQ(damaged.code, 2);
-  EXPECT_EQ(damaged.err.rfind("deformlab: error: a results file in " + (dir_ / "r").string() +
-                                  " (its manifest.json or a cell) holds a value of another kind", 0),
+  EXPECT_EQ(damaged.err.rfind("deformlab: error: " + (dir_ / "r" / "manifest.json").string() +
+                                  " holds a value of another kind than the report reads (cannot use value() with null)", 0),
             0u) << damaged.err;
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
 }
