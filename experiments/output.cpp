@@ -107,11 +107,15 @@ void finish_stopped_commit(const fs::path& dir) {
   }
 }
 
-// `dir` as an absolute path without a trailing separator.
-fs::path absolute_folder(const fs::path& dir) {
+// The folders that creating `dir` makes, as absolute paths through the links that exist now,
+// the deepest first.
+std::vector<fs::path> folders_to_make(const fs::path& dir) {
   std::error_code ec;
-  fs::path p = fs::absolute(dir, ec).lexically_normal();
-  return p.has_filename() ? p : p.parent_path();
+  fs::path p = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  if (!p.has_filename()) p = p.parent_path();
+  std::vector<fs::path> made;
+  for (; !ec && p.has_relative_path() && !fs::exists(p, ec); p = p.parent_path()) made.push_back(p);
+  return made;
 }
 
 }  // namespace
@@ -161,8 +165,7 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
     : dir_(dir), outputs_(std::move(outputs)) {
   std::error_code ec;
   require_folder_or_nothing(dir_);
-  for (fs::path p = absolute_folder(dir_); p.has_relative_path() && !fs::exists(p, ec); p = p.parent_path()) created_ = p;
-  if (created_.empty()) finish_stopped_commit(dir_);
+  if (fs::exists(dir_, ec)) finish_stopped_commit(dir_);
   require_replaceable(outputs_);
   require_replaceable({"manifest.json"});
   // The earlier run's outputs, by its manifest ("files"; one without the list predates it and
@@ -176,19 +179,31 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
                                 "' holds a manifest.json that is no deformlab run's: move it or give another --out");
   }
   require_ours(writes);
+  created_ = folders_to_make(dir_);
   fs::create_directories(dir_, ec);
-  if (ec) throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
+  if (ec) {
+    remove_created();
+    throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
+  }
   reclaim_temporaries(dir_);
   staging_ = dir_ / (std::string(kStagingTag) + std::to_string(::getpid()));
   fs::create_directory(staging_, ec);
-  if (ec) throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
+  if (ec) {
+    remove_created();
+    throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
+  }
+}
+
+void OutputDir::remove_created() const {
+  std::error_code ec;
+  for (const fs::path& p : created_)
+    if (!fs::is_empty(p, ec) || !fs::remove(p, ec)) return;
 }
 
 OutputDir::~OutputDir() {
   std::error_code ec;
   fs::remove_all(staging_, ec);
-  if (created_.empty()) return;
-  for (fs::path p = absolute_folder(dir_); fs::is_empty(p, ec) && fs::remove(p, ec) && p != created_;) p = p.parent_path();
+  remove_created();
 }
 
 void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {

@@ -57,8 +57,8 @@ class OutputDir {
   // already must be the earlier run's, else it is someone else's and std::invalid_argument is
   // thrown rather than replace it.
   OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes);
-  // Removes the staging folder, and the output folder too if this object created it and
-  // nothing was committed.
+  // Removes the staging folder, and the folders the constructor made (the output folder and
+  // any above it) that nothing was committed into.
   ~OutputDir();
   OutputDir(const OutputDir&) = delete;
   OutputDir& operator=(const OutputDir&) = delete;
@@ -82,7 +82,8 @@ class OutputDir {
   std::filesystem::path dir_, staging_;
   std::vector<std::string> outputs_;
   std::set<std::string> earlier_;  // of `outputs_`, those the folder's earlier run wrote
-  std::filesystem::path created_;  // the outermost folder the constructor created, or empty
+  std::vector<std::filesystem::path> created_;  // the folders the constructor made, the deepest first
+  void remove_created() const;  // those of them that are empty, from the deepest up to one that is not
 };
 
 // Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their
