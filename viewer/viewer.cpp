@@ -163,8 +163,9 @@ class Viewer {
     r_.set_camera(c);
   }
 
+  // Ends a drag (also one that a reset ends: the node goes back to rest).
   void release() {
-    if (mouse_ == Mouse::drag_node) {
+    if (mouse_ == Mouse::drag_node && s_.dragged() >= 0) {
       const int node = s_.dragged();
       const Vec3f x = s_.pipeline().state().x[node];
       nlohmann::json pick = {{"frame", frame_}, {"node", node}, {"target", to_json(target_)}, {"position", to_json(x)}};
@@ -234,6 +235,7 @@ class Viewer {
   }
 
   void reset() {
+    release();
     s_.reset();
     message_.clear();
     paused_ = diverged_ = false;

@@ -79,6 +79,26 @@ TEST_F(View, DraggedNodeFollowsTheCursorRay) {
   EXPECT_EQ(s["steps"], 80);
 }
 
+// A reset (backspace) during a drag ends the drag there; the moves and the release after it
+// drag nothing (they had read node -1).
+TEST_F(View, AResetEndsTheDrag) {
+  const int node = 8 * 16 + 8;
+  const auto p = camera().pixel(model().rest_position[node], kW, kH);
+  const nlohmann::json events = {{{"frame", 0}, {"event", "press"}, {"x", p[0]}, {"y", p[1]}, {"button", "left"}},
+                                 {{"frame", 1}, {"event", "move"}, {"x", p[0] + 8}, {"y", p[1] - 10}},
+                                 {{"frame", 3}, {"event", "key"}, {"key", "backspace"}},
+                                 {{"frame", 4}, {"event", "move"}, {"x", p[0] + 16}, {"y", p[1] - 20}},
+                                 {{"frame", 5}, {"event", "release"}}};
+  const fs::path script = write("reset.json", nlohmann::json{{"events", events}}.dump());
+  const Result r = view("--pipeline cpu --max-frames 8 --script " + script.string() + " --summary " +
+                        (dir_ / "summary.json").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json s = summary();
+  ASSERT_EQ(s["drags"].size(), 1u) << s.dump();
+  EXPECT_EQ(s["drags"][0]["frame"], 3);
+  EXPECT_EQ(s["drags"][0]["node"], node);
+}
+
 TEST_F(View, SavedSessionReplaysToTheSameState) {
   const Model m = model();
   const auto p = camera().pixel(m.rest_position[5 * 16 + 10], kW, kH);
