@@ -1,13 +1,18 @@
 #include "script.hpp"
 
+#include <cfloat>
+#include <charconv>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
 
+#include "core/integrator.hpp"
 #include "core/json_file.hpp"
+#include "experiments/pipelines.hpp"
 #include "core/write_error.hpp"
 
 namespace deformlab::viewer {
@@ -49,8 +54,10 @@ Event from_json(const nlohmann::json& j) {
     if (!v.is_string()) throw std::invalid_argument(key + " must be a string");
     return v.get<std::string>();
   };
+  // Window coordinates and scroll steps: a cursor far outside any window made the drag's target
+  // or the camera not finite.
   auto number = [](const nlohmann::json& v, const std::string& key) {
-    if (!v.is_number()) throw std::invalid_argument(key + " must be a number");
+    if (!v.is_number() || !(std::abs(v.get<double>()) <= 1e6)) throw std::invalid_argument(key + " must be a number within ±1e6");
     return v.get<double>();
   };
   for (const auto& [key, v] : j.items()) {
@@ -74,8 +81,20 @@ Event from_json(const nlohmann::json& j) {
         throw std::invalid_argument("key '" + e.key + "' is not a key name (a-z, space, backspace)");
     } else if (key == "file") {
       e.file = text(v, key);
-    } else if (key == "dt" && v.is_number()) {  // set
-      e.settings[key] = v.dump();
+    } else if (key == "dt") {  // set: a number or its text (as a saved script has it), as --dt takes it
+      const std::string t = v.is_string() ? v.get<std::string>() : v.dump();
+      double dt = 0;
+      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), dt);
+      if (!(v.is_number() || v.is_string()) || ec != std::errc() || end != t.data() + t.size() ||
+          !(dt >= double(FLT_MIN) && dt <= double(FLT_MAX)))
+        throw std::invalid_argument("dt must be a number of seconds > 0 within float's normal range");
+      e.settings[key] = t;
+    } else if (key == "pipeline" && (!v.is_string() || !pipelines().find(v.get<std::string>()))) {
+      throw std::invalid_argument(v.is_string() ? "unknown pipeline '" + v.get<std::string>() + "' (valid: " + pipelines().names() + ")"
+                                                : "pipeline must be a string");
+    } else if (key == "integrator" && (!v.is_string() || !parse_integrator(v.get<std::string>()))) {
+      throw std::invalid_argument(v.is_string() ? "unknown integrator '" + v.get<std::string>() + "' (valid: " + integrator_names() + ")"
+                                                : "integrator must be a string");
     } else {
       e.settings[key] = text(v, key);
     }
