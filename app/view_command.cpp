@@ -30,13 +30,15 @@ void require_file_target(const std::string& file, const std::string& what) {
 
 int view_command(const ViewArgs& a) {
   return report_errors([&]() -> int {
-    if (a.steps_per_frame < 1) throw std::invalid_argument("--steps-per-frame must be at least 1");
+    // A frame's steps run between the window's events (and signals): the panel goes to 200.
+    if (a.steps_per_frame < 1 || a.steps_per_frame > 10000) throw std::invalid_argument("--steps-per-frame must be in 1 to 10000");
     if (a.seconds && !a.record) throw std::invalid_argument("--seconds needs --record");
     if (a.seconds && !(*a.seconds > 0 && *a.seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
     if (a.max_frames && *a.max_frames < 1) throw std::invalid_argument("--max-frames must be at least 1");
     const std::vector<int> size = parse_size(a.size, 2, "--size");
     check_run_flags(a.run);
     if (size[0] > 16384 || size[1] > 16384) throw std::invalid_argument("--size: at most 16384x16384");
+    if (a.record && size[1] < 2) throw std::invalid_argument("--record needs a window 2 pixels high or more (H.264 in yuv420p)");
     // Each file the session reads or writes is one flag's (or one screenshot's).
     std::set<std::string> files;
     auto own = [&](const std::string& file, const std::string& what) {

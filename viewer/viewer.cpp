@@ -57,7 +57,7 @@ class Viewer {
 
   int loop() {
     int code = 0;
-    const int video_frames = o_.seconds > 0 ? int(std::lround(o_.seconds * kVideoFps)) : 0;
+    const int video_frames = o_.seconds > 0 ? std::max(1, int(std::lround(o_.seconds * kVideoFps))) : 0;  // 0: no limit
     while (!quit_ && !w_.should_close() && !g_signal) {
       std::vector<Event> events;
       for (; next_ < script_.size() && script_[next_].frame <= frame_; ++next_) events.push_back(script_[next_]);

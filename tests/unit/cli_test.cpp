@@ -342,6 +342,17 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
 }
 
+// The viewer checks its flags before it opens a window (no display needed for these).
+TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
+  for (const auto& [args, error] : std::vector<std::pair<std::string, std::string>>{
+           {"--steps-per-frame 2147483647", "--steps-per-frame must be in 1 to 10000"},
+           {"--size 200x1 --record " + (dir_ / "x.mp4").string(), "--record needs a window 2 pixels high or more"}}) {
+    const Result r = run("view " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err.rfind("deformlab: error: " + error, 0), 0u) << r.err;
+  }
+}
+
 // deformlab-bench checks a size against the host's memory before it builds the model. Its
 // largest cloth, 32768 x 32768 (2^30 nodes), needs 52 GiB for that.
 TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
