@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "core/memory.hpp"
 #include "generate.hpp"
@@ -71,18 +73,33 @@ auto naming(const std::string& what, F&& f) {
 }
 
 // Refuses a fill whose tetrahedra of `cell_size` would make more than 2^30 nodes, or a model
-// that would not fit, estimated from the volume the surface encloses (before meshing).
+// that would not fit, estimated from the volume the surface encloses (before meshing): by the
+// divergence theorem over each connected part's triangles, its magnitude, so that parts wound
+// the other way add rather than cancel (a cavity counts as filled: an upper bound).
 void check_fill_size(const Mesh& surface, float cell_size) {
-  double volume = 0;  // the divergence theorem over the (closed, consistently wound) triangles
+  std::vector<std::int32_t> root(surface.position.size());
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&](std::int32_t v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  for (const auto& t : surface.triangle) {
+    const std::int32_t r = find(t[0]);
+    root[find(t[1])] = r;
+    root[find(t[2])] = r;
+  }
+  std::unordered_map<std::int32_t, double> part;  // a part's root -> its signed volume
   for (const auto& t : surface.triangle) {
     auto at = [&](std::int32_t v) {
       const Vec3f& p = surface.position[v];
       return Vec3d{p.x, p.y, p.z};
     };
     const Vec3d a = at(t[0]), b = at(t[1]), c = at(t[2]);
-    volume += dot(a, cross(b, c)) / 6.0;
+    part[find(t[0])] += dot(a, cross(b, c)) / 6.0;
   }
-  const double n = estimated_filled_nodes(std::abs(volume), cell_size);
+  double volume = 0;
+  for (const auto& [r, v] : part) volume += std::abs(v);
+  const double n = estimated_filled_nodes(volume, cell_size);
   std::ostringstream about;
   about << "filling with tetrahedra of cell_size " << cell_size << " m would make " << about_nodes(n);
   if (n > double(std::int64_t(1) << 30)) throw std::invalid_argument(about.str() + ", over the limit of 2^30");

@@ -232,6 +232,12 @@ const std::vector<BadInput>& cases() {
       mesh("mesh_fill_too_fine", "{\"file\": \"t.obj\", \"fill\": \"tetrahedra\", \"cell_size\": 0.00001}",
            "filling with tetrahedra of cell_size 1e-05 m would make about 1e+14 nodes, over the limit of 2^30",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", "t.obj"),
+      // Two parts wound against each other: their volumes add (they cancelled: no limit).
+      mesh("mesh_fill_parts_wound_apart", "{\"file\": \"t.obj\", \"fill\": \"tetrahedra\", \"cell_size\": 0.00001}",
+           "filling with tetrahedra of cell_size 1e-05 m would make about 2e+14 nodes, over the limit of 2^30",
+           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+           "v 5 0 0\nv 6 0 0\nv 5 1 0\nv 5 0 1\nf 5 6 7\nf 5 8 6\nf 5 7 8\nf 6 8 7\n",
+           "t.obj"),
       mesh("mesh_order", "{\"file\": \"m.obj\", \"order\": \"hilbert\"}",
            "s.json.model.order: expected one of: file, shuffled, rcm, morton"),
       mesh("mesh_size_key", "{\"size\": [4, 4]}", "s.json.model.size: not a key of a mesh model"),
