@@ -151,6 +151,22 @@ std::int64_t triangles_bounding_no_tetrahedron(const Mesh& m, std::vector<std::a
 
 }  // namespace
 
+namespace {
+
+// Whether a .msh file Gmsh wrote ends with its last section's end tag: Gmsh does not say when a
+// write fails (on a full disk it left an empty file).
+bool ends_whole(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in.tellg();
+  std::string tail(64, '\0');
+  const std::streamoff n = std::min<std::streamoff>(std::max<std::streamoff>(size, 0), std::streamoff(tail.size()));
+  in.seekg(size - n);
+  in.read(tail.data(), std::streamsize(n));
+  return in && tail.find("$EndElements") != std::string::npos;
+}
+
+}  // namespace
+
 void write_gmsh_model(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path to(path);
@@ -163,7 +179,13 @@ void write_gmsh_model(const std::string& path) {
   try {
     if (!to.parent_path().empty()) fs::create_directories(to.parent_path());
     gmsh::write(partial.string());
+    if (!ends_whole(partial)) {
+      fs::remove(partial, ec);
+      throw WriteError("writing '" + path + "': the file came out short (is the disk full?)");
+    }
     fs::rename(partial, to);
+  } catch (const WriteError&) {
+    throw;
   } catch (const fs::filesystem_error& e) {
     fs::remove(partial, ec);
     throw WriteError("writing '" + path + "': " + e.code().message());
