@@ -71,6 +71,24 @@ constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".de
 
 fs::path temporary(const fs::path& name) { return name.string().append(kTemporaryTag) + std::to_string(::getpid()); }
 
+void write_atomically(const fs::path& file, const std::string& text) {
+  const fs::path tmp = temporary(file);
+  try {
+    write_file(tmp.string(), [&](std::ostream& out) { out << text; }, true);
+  } catch (const std::runtime_error&) {  // named as the file asked for, with the write's reason
+    const int error = errno;
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw write_error(file.string(), error);
+  }
+  if (std::rename(tmp.c_str(), file.c_str()) != 0) {
+    const int error = errno;
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw write_error(file.string(), error);
+  }
+}
+
 bool is_temporary(const std::string& name) { return name.find(kTemporaryTag) != std::string::npos; }
 
 namespace {

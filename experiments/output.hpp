@@ -40,6 +40,9 @@ std::string foreign_frames_entry(const std::filesystem::path& frames);
 // temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other
 // files are never taken for them.
 std::filesystem::path temporary(const std::filesystem::path& name);
+// Writes `file` whole or not at all: into its temporary, renamed over it once written (on a
+// failure the temporary is removed and write_error thrown).
+void write_atomically(const std::filesystem::path& file, const std::string& text);
 // Whether `name` is a temporary's.
 bool is_temporary(const std::string& name);
 // Removes the temporaries and staging folders in `dir` whose process is gone.

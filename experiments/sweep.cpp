@@ -222,12 +222,6 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 #endif
 }
 
-void write_atomically(const fs::path& file, const std::string& text) {
-  const fs::path tmp = temporary(file);
-  write_file(tmp.string(), [&](std::ostream& out) { out << text; });
-  fs::rename(tmp, file);
-}
-
 namespace {
 
 // What keeps a cell's JSON from being one as cells are written ("its \"method\" is missing or

@@ -114,7 +114,5 @@ void require_same_experiment(const std::filesystem::path& dir, const std::string
 // A cell file's result, or null when the file is not a cell result (damaged, edited).
 nlohmann::json read_cell(const std::filesystem::path& file);
 
-// Writes `text` to `file` through a temporary file and a rename.
-void write_atomically(const std::filesystem::path& file, const std::string& text);
 
 }  // namespace deformlab

@@ -13,7 +13,7 @@
 #include "core/integrator.hpp"
 #include "core/json_file.hpp"
 #include "experiments/pipelines.hpp"
-#include "core/write_error.hpp"
+#include "experiments/output.hpp"
 
 namespace deformlab::viewer {
 namespace {
@@ -150,9 +150,7 @@ std::vector<Event> read_script(const std::string& path) {
 void write_script(const std::string& path, const std::vector<Event>& events) {
   nlohmann::json list = nlohmann::json::array();
   for (const Event& e : events) list.push_back(to_json(e));
-  const std::string tmp = path + ".tmp";
-  write_file(tmp, [&](std::ostream& out) { out << nlohmann::json{{"events", list}}.dump(1) << "\n"; });
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw write_error(path);
+  write_atomically(path, nlohmann::json{{"events", list}}.dump(1) + "\n");
 }
 
 }  // namespace deformlab::viewer

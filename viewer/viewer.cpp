@@ -14,7 +14,7 @@
 #include "core/number_text.hpp"
 #include "core/one_line.hpp"
 #include "core/run.hpp"
-#include "core/write_error.hpp"
+#include "experiments/output.hpp"
 #include "gl/context.hpp"
 #include "experiments/pipelines.hpp"
 #include "orbit.hpp"
@@ -83,7 +83,7 @@ class Viewer {
       code = 1;
     }
     if (!o_.summary.empty()) code = std::max(code, write_summary());
-    return code;
+    return failed_writes_ ? std::max(code, 1) : code;
   }
 
  private:
@@ -394,7 +394,16 @@ class Viewer {
     for (int y = 0; y < w_.height() / 2; ++y)
       std::swap_ranges(px.begin() + long(y * row), px.begin() + long((y + 1) * row),
                        px.begin() + long((w_.height() - 1 - y) * row));
-    const bool ok = stbi_write_png(file.c_str(), w_.width(), w_.height(), 4, px.data(), int(row));
+    std::string png;
+    bool ok = stbi_write_png_to_func([](void* to, void* data, int size) { static_cast<std::string*>(to)->append(static_cast<const char*>(data), std::size_t(size)); },
+                                     &png, w_.width(), w_.height(), 4, px.data(), int(row)) != 0;
+    try {
+      if (ok) write_atomically(file, png);  // whole or not at all: an old file of that name stays otherwise
+    } catch (const std::runtime_error& e) {
+      ok = false;
+      std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
+    }
+    failed_writes_ = failed_writes_ || !ok;
     const gl::Camera& c = r_.camera();
     summary_["screenshots"].push_back({{"frame", frame_},
                                        {"file", file},
@@ -417,7 +426,7 @@ class Viewer {
     summary_["dt"] = shortest_decimal(s_.params().dt);
     summary_["largest_move_m"] = moved;  // of any node since the viewer opened
     try {
-      write_file(o_.summary, [&](std::ostream& out) { out << summary_.dump(1) << "\n"; });
+      write_atomically(o_.summary, summary_.dump(1) + "\n");
     } catch (const std::runtime_error& e) {
       std::cerr << "deformlab: error: " << e.what() << "\n";
       return 1;
@@ -437,6 +446,7 @@ class Viewer {
   std::size_t next_ = 0;
   int frame_ = 0;
   bool paused_ = false, single_ = false, quit_ = false, diverged_ = false;
+  bool failed_writes_ = false;  // a screenshot that could not be written: the exit code is 1
   Mouse mouse_ = Mouse::none;
   double mx_ = 0, my_ = 0;
   Vec3f plane_point_, plane_normal_, target_;

@@ -99,6 +99,17 @@ TEST_F(View, AResetEndsTheDrag) {
   EXPECT_EQ(s["drags"][0]["node"], node);
 }
 
+// A screenshot that cannot be written is said on stderr and in the summary, and the session
+// exits 1; the summary is still written.
+TEST_F(View, AScreenshotThatCannotBeWrittenEndsInExit1) {
+  const fs::path script = write("shot.json", R"({"events": [{"frame": 1, "event": "screenshot", "file": "/proc/x.png"},
+                                                            {"frame": 2, "event": "quit"}]})");
+  const Result r = view("--pipeline cpu --script " + script.string() + " --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("deformlab: error: cannot write /proc/x.png: "), std::string::npos) << r.err;
+  EXPECT_EQ(summary()["screenshots"][0]["written"], false);
+}
+
 TEST_F(View, SavedSessionReplaysToTheSameState) {
   const Model m = model();
   const auto p = camera().pixel(m.rest_position[5 * 16 + 10], kW, kH);
