@@ -57,6 +57,26 @@ json read_calibration(const std::filesystem::path& file) {
   const json j = read_json_file(file.string(), "calibration file");
   if (!j.is_object())
     throw std::invalid_argument(file.string() + ": not a JSON object (expected `deformlab calibrate --out`'s file)");
+  // The measures a report divides by, each where given a number in a range a device can have.
+  struct Measure {
+    const char *object, *key;
+    double least, most;
+  };
+  for (const Measure& m : {Measure{"copy", "GB_per_s", 1e-3, 1e6}, Measure{"compute_copy", "GB_per_s", 1e-3, 1e6},
+                           Measure{"compute_copy_gl_buffers", "GB_per_s", 1e-3, 1e6},
+                           Measure{"transform_feedback", "vertices_per_s", 1, 1e14},
+                           Measure{"floor", "us_per_hand_off", 1e-3, 1e6}}) {
+    if (!j.contains(m.object)) continue;
+    const std::string at = file.string() + "." + m.object;
+    if (!j[m.object].is_object()) throw std::invalid_argument(at + ": expected an object");
+    if (!j[m.object].contains(m.key)) continue;
+    const json& v = j[m.object][m.key];
+    if (!v.is_number() || !(v.get<double>() >= m.least && v.get<double>() <= m.most)) {
+      std::ostringstream range;
+      range << m.least << " to " << m.most;
+      throw std::invalid_argument(at + "." + m.key + ": expected a number from " + range.str());
+    }
+  }
   if (!ceilings_of(j).any())
     throw std::invalid_argument(file.string() +
                                 ": no ceilings in it (copy.GB_per_s, compute_copy.GB_per_s, "

@@ -400,9 +400,18 @@ const std::vector<BadInput>& cases() {
       {"report_of_another_experiment", "experiment table2 --report-only --out {dir}", "holds experiment 'quick', not 'table2'",
        {{"manifest.json", R"({"experiment": {"name": "quick"}})"}}},
       {"calibration_missing", "experiment quick --calibration {dir}/none.json", "cannot open calibration file"},
+      {"calibration_denormal", "experiment quick --calibration {dir}/c.json",
+       "c.json.compute_copy.GB_per_s: expected a number from 0.001 to 1e+06", {{"c.json", R"({"compute_copy": {"GB_per_s": 5e-324}})"}}},
+      {"calibration_text", "experiment quick --calibration {dir}/c.json",
+       "c.json.copy.GB_per_s: expected a number from 0.001 to 1e+06", {{"c.json", R"({"copy": {"GB_per_s": "NaN"}})"}}},
+      {"calibration_negative", "experiment quick --calibration {dir}/c.json",
+       "c.json.floor.us_per_hand_off: expected a number from 0.001 to 1e+06",
+       {{"c.json", R"({"copy": {"GB_per_s": 3000}, "floor": {"us_per_hand_off": -4}})"}}},
+      {"calibration_not_an_object", "experiment quick --calibration {dir}/c.json", "c.json.copy: expected an object",
+       {{"c.json", R"({"copy": 3000})"}}},
       {"calibration_list", "experiment quick --calibration {dir}/c.json", "not a JSON object", {{"c.json", "[1, 2]"}}},
       {"calibration_empty", "experiment quick --calibration {dir}/c.json", "no ceilings in it",
-       {{"c.json", "{\"copy\": {\"GB_per_s\": 0}}"}}},
+       {{"c.json", "{\"copy\": {\"device\": \"none\"}}"}}},
   };
   return all;
 }
