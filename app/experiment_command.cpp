@@ -24,7 +24,7 @@ int experiment_command(const ExperimentArgs& a) {
     sweep = parse_sweep(x.raw, a.file);
     if (!sweep) throw std::invalid_argument(a.file + ": has no \"sweep\" (run it with `deformlab run --experiment`)");
     if (!sweep->sizes.empty() && x.scene.model.topology == Topology::general)
-      throw std::invalid_argument(a.file + ".sweep.sizes: the scene's model is a mesh, whose file gives its size (sweep \"models\")");
+      throw std::invalid_argument(a.file + ".sweep.sizes: the scene's model is a mesh, whose file or \"generate\" gives its size (sweep \"models\")");
     if (a.max_size && !sweep->models.empty()) throw std::invalid_argument("--max-size: this sweep has models, not grid sizes");
     if (a.max_size) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });

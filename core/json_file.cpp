@@ -18,8 +18,9 @@ namespace {
 // - a key given twice in one object (the library keeps the last) and where that object is
 //   ("spheres[1]"): the keys of each object still open, and where each open container sits in
 //   its parent;
-// - arrays and objects nested deeper than kMaxDepth, which the library's tree would copy and
-//   free by recursion, as deep as the nesting (a stack overflow at 100 000 levels).
+// - arrays and objects nested deeper than kMaxDepth, which the library's tree would copy,
+//   compare and write out by recursion, as deep as the nesting (a stack overflow at 100 000
+//   levels).
 class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
  public:
   static constexpr std::size_t kMaxDepth = 256;

@@ -215,10 +215,9 @@ MeshShape shape(const json& j, const std::string& where) {
     const float v = length(z[k], where + ".size[" + std::to_string(k) + "]");
     s.size[sheet && k == 1 ? 2 : int(k)] = v;
   }
-  const auto [shortest, longest] = std::minmax_element(z.begin(), z.end(), [](const json& a, const json& b) {
-    return a.get<double>() < b.get<double>();
-  });
-  if (longest->get<double>() > kLongestRatio * shortest->get<double>())
+  const std::vector<float> sides = sheet ? std::vector<float>{s.size.x, s.size.z} : std::vector<float>{s.size.x, s.size.y, s.size.z};
+  const auto [shortest, longest] = std::minmax_element(sides.begin(), sides.end());
+  if (double(*longest) > kLongestRatio * double(*shortest))
     bad(where + ".size", "its longest side is more than 1e6 times its shortest (Gmsh would merge the shortest's ends)");
   s.cell_size = length(j["cell_size"], where + ".cell_size");
 
@@ -308,7 +307,8 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   // that the springs' squared lengths overflow float (a width of 3e38 m ran as a divergence).
   if (j.contains("spacing")) {
     m.spacing = num(j["spacing"], where + ".spacing", Range::non_negative);
-    if (m.spacing > 0) length(j["spacing"], where + ".spacing");
+    if (m.spacing > 0 && (m.spacing < float(kShortestLength) || m.spacing > float(kLongestLength)))
+      bad(where + ".spacing", "expected a length within [1e-6, 1e6] m, or 0 (from the width)");
   }
   if (j.contains("width")) {
     if (m.spacing > 0 && j.contains("spacing"))

@@ -130,8 +130,13 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};
   for (const auto& p : s.pipelines)
     if (!pipelines().find(p)) bad(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
-  for (const auto& i : s.integrators)
-    if (!parse_integrator(i)) bad(integrators_key, "unknown integrator '" + i + "' (valid: " + integrator_names() + ")");
+  for (std::size_t k = 0; k < s.integrators.size(); ++k) {
+    const auto i = parse_integrator(s.integrators[k]);
+    if (!i) bad(integrators_key, "unknown integrator '" + s.integrators[k] + "' (valid: " + integrator_names() + ")");
+    for (std::size_t e = 0; e < k; ++e)
+      if (parse_integrator(s.integrators[e]) == i)
+        bad(integrators_key, "'" + s.integrators[k] + "' names the integrator '" + s.integrators[e] + "' names");
+  }
   for (const auto& o : s.option_sets)
     for (const auto& [name, value] : o) {
       const bool read = std::any_of(s.pipelines.begin(), s.pipelines.end(), [&, &name = name](const std::string& p) {

@@ -132,11 +132,15 @@ std::int64_t triangles_bounding_no_tetrahedron(const Mesh& m, std::vector<std::a
     }
   };
   std::unordered_map<Face, std::int64_t, Hash> loose;  // sorted triangle -> how often it is given
+  std::vector<char> on_one(m.position.size());         // the nodes of those triangles
   for (Face& f : triangles) {
     std::sort(f.begin(), f.end());
     ++loose[f];
+    for (std::int32_t v : f) on_one[std::size_t(v)] = 1;
   }
-  for (std::size_t t = 0; t < m.tetrahedron.size() && !loose.empty(); ++t)
+  for (std::size_t t = 0; t < m.tetrahedron.size() && !loose.empty(); ++t) {
+    const auto& tet = m.tetrahedron[t];
+    if (on_one[tet[0]] + on_one[tet[1]] + on_one[tet[2]] + on_one[tet[3]] < 3) continue;  // most: none of its faces
     for (int skip = 0; skip < 4; ++skip) {
       Face f;
       for (int c = 0, o = 0; c < 4; ++c)
@@ -144,6 +148,7 @@ std::int64_t triangles_bounding_no_tetrahedron(const Mesh& m, std::vector<std::a
       std::sort(f.begin(), f.end());
       loose.erase(f);
     }
+  }
   std::int64_t count = 0;
   for (const auto& [face, times] : loose) count += times;
   return count;
@@ -221,6 +226,11 @@ Mesh read_gmsh_model(const std::string& what, std::vector<std::string>* notes) {
     if (dim == 3 && t != 4) throw std::invalid_argument(what + ": holds " + name + " elements (only 4-node tetrahedra are read)");
     if (dim == 2 && !volume && t != 2)
       throw std::invalid_argument(what + ": holds " + name + " elements (only 3-node triangles are read)");
+    if (dim == 2 && volume && t != 2 && notes) {  // beside tetrahedra: left out, as triangles that bound none
+      std::vector<std::size_t> tags, element_nodes;
+      gmsh::model::mesh::getElementsByType(t, tags, element_nodes);
+      notes->push_back("left out " + std::to_string(tags.size()) + " " + name + " elements");
+    }
   }
   std::vector<std::size_t> elements, nodes;
   gmsh::model::mesh::getElementsByType(volume ? 4 : 2, elements, nodes);

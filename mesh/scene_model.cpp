@@ -16,8 +16,8 @@ namespace deformlab {
 namespace {
 
 // Scales and transforms a mesh's vertices, refusing one that is not finite as read (before the
-// transform spreads a NaN to its other coordinates) or that lies, as read or placed, farther
-// than kFarthest from the origin, where a spring's squared length can overflow float.
+// transform spreads a NaN to its other coordinates) or one with a coordinate, once placed, past
+// ±kFarthest, where a spring's squared length can overflow float.
 constexpr float kFarthest = 1e15f;  // m
 void place(Mesh& m, const MeshSpec& s) {
   const auto& t = s.transform;
@@ -29,7 +29,8 @@ void place(Mesh& m, const MeshSpec& s) {
     if (finite_vertex(p) && !far(p)) continue;
     std::ostringstream os;
     os << (far(from) ? "the vertex (" : "its scale and transform take the vertex (") << from.x << ", " << from.y << ", "
-       << from.z << (far(from) ? ") lies" : ")") << " more than 1e15 m from the origin, where squared lengths overflow float";
+       << from.z << (far(from) ? ") lies" : ")") << " more than 1e15 m from the origin along an axis, where squared "
+       << "lengths overflow float";
     throw std::invalid_argument(os.str());
   }
 }

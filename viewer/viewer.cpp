@@ -260,8 +260,9 @@ class Viewer {
         else bad = "unknown integrator '" + v + "'";
       } else if (k == "dt") {
         const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), dt);
-        if (ec == std::errc::result_out_of_range) bad = "dt '" + v + "' is out of the float range";
-        else if (ec != std::errc() || end != v.data() + v.size()) bad = "dt '" + v + "' is not a number";
+        if (end != v.data() + v.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+          bad = "dt '" + v + "' is not a number";
+        else if (ec == std::errc::result_out_of_range) bad = "dt '" + v + "' is out of the float range";
       } else if (k == "options") {
         const auto eq = v.find('=');
         if (eq == std::string::npos) bad = "option '" + v + "': expected NAME=VALUE";

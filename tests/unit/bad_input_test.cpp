@@ -194,8 +194,8 @@ const std::vector<BadInput>& cases() {
            "$EndNodes\n$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n",
            "m.msh"),
       mesh("mesh_scale_overflow", "{\"file\": \"m.obj\", \"scale\": 1e38}",
-           "m.obj': its scale and transform take the vertex (10, 0, 0) more than 1e15 m from the origin, where squared "
-           "lengths overflow float",
+           "m.obj': its scale and transform take the vertex (10, 0, 0) more than 1e15 m from the origin along an "
+           "axis, where squared lengths overflow float",
            "v 0 0 0\nv 10 0 0\nv 0 1 0\nf 1 2 3\n"),
       mesh("mesh_vertex_far", "{\"file\": \"m.obj\"}",
            "m.obj': the vertex (-3e+38, 0, 0) lies more than 1e15 m from the origin", "v -3e38 0 0\nv 3e38 0 0\nv 0 1 0\nf 1 2 3\n"),
@@ -363,6 +363,8 @@ const std::vector<BadInput>& cases() {
         {"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}}},
       {"run_experiment_bad_sweep", "run --experiment {dir}/x.json", "x.json.sweep: expected an object",
        {{"x.json", R"({"sweep": 5})"}}},
+      {"experiment_base_empty", "run --experiment {dir}/x.json", "x.json.base: expected an experiment name",
+       {{"x.json", R"({"base": ""})"}}},
       {"experiment_base_nul", "run --experiment {dir}/x.json", "x.json.base: expected an experiment name (without a NUL",
        {{"x.json", R"({"base": "paper-drag\u0000x"})"}}},
       mesh("mesh_file_nul", R"({"file": "m.obj\u0000.txt"})", "s.json.model.file: expected a file name (without a NUL"),

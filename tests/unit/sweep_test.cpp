@@ -426,6 +426,9 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "integrators": ["verlet", "verlet"]})")
                 .find("sweep.integrators: 'verlet' is named twice"),
             std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "integrators": ["verlet", "midpoint-verlet"]})")
+                .find("sweep.integrators: 'midpoint-verlet' names the integrator 'verlet' names"),
+            std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cuda-tiled"], "options": [{"tile": "8x8"}, {"tile": "8x8"}]})")
                 .find("sweep.options: an option set is named twice"),
             std::string::npos);
