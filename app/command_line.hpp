@@ -5,6 +5,9 @@
 // and inf pass to the options' own range checks, which name what the option takes.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <omp.h>
+
+#include <algorithm>
 #include <charconv>
 #include <cstdlib>
 #include <iomanip>
@@ -12,6 +15,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "core/one_line.hpp"
 
@@ -67,6 +71,16 @@ inline void decimal_numbers_only(CLI::App& app) {
       if (whole || type.starts_with("FLOAT"))
         opt->check(CLI::Validator([whole](std::string& v) { return decimal_problem(v, whole); }, ""));
     }
+}
+
+// OpenMP's threads at most 4 a hardware thread, with a note where more were asked for
+// (OMP_NUM_THREADS=100000 ended in a crash inside the OpenMP runtime).
+inline void cap_openmp_threads(const std::string& program) {
+  const int hardware = int(std::max(1u, std::thread::hardware_concurrency()));
+  if (omp_get_max_threads() <= 4 * hardware) return;
+  std::cerr << program << ": note: OMP_NUM_THREADS asks for " << omp_get_max_threads() << " threads on " << hardware
+            << " hardware threads; using " << hardware << "\n";
+  omp_set_num_threads(hardware);
 }
 
 // Parses `argv` into `cli`: help is printed (0); an unknown command, or a parse error, is one

@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
+  deformlab::app::cap_openmp_threads("deformlab");
   if (*run) return deformlab::app::run_command(a);
   if (*experiment) return deformlab::app::experiment_command(ex);
   if (*list) return deformlab::app::list_command();

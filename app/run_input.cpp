@@ -100,8 +100,8 @@ void apply_param_flags(const RunArgs& a, Params& p) {
   // Read as floats: a dt under float's normal range is 0 or a subnormal whose inverse overflows.
   if (a.dt && !(*a.dt >= std::numeric_limits<float>::min() && *a.dt <= 3e38))
     throw BadInput("--dt must be a positive number of seconds from 1.18e-38 (the smallest normal float) to 3e38");
-  if (a.threshold && !(std::isfinite(*a.threshold) && *a.threshold > 0 && *a.threshold <= 3e38))
-    throw BadInput("--threshold must be a positive finite number of metres");
+  if (a.threshold && !(*a.threshold >= std::numeric_limits<float>::min() && *a.threshold <= 3e38))
+    throw BadInput("--threshold must be a positive number of metres from 1.18e-38 (the smallest normal float) to 3e38");
   if (a.threshold) p.threshold = float(*a.threshold);
   if (a.check_every && *a.check_every < 1) throw BadInput("--check-every must be at least 1");
   if (a.check_every) p.check_every = *a.check_every;

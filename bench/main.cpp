@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
 #endif
   deformlab::app::decimal_numbers_only(cli);
   try {
+    deformlab::app::cap_openmp_threads("deformlab-bench");  // before parsing: the benches run in its callbacks
     if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   } catch (const std::invalid_argument& e) {  // bad input
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";

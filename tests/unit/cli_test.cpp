@@ -342,6 +342,15 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
 }
 
+// More OpenMP threads than 4 a hardware thread are capped, with a note (100000 crashed the
+// OpenMP runtime).
+TEST_F(Cli, OpenMpThreadsPastTheHardwareAreCapped) {
+  const std::string program = std::string("OMP_NUM_THREADS=100000 ") + DEFORMLAB_EXE;
+  const Result r = run("run --grid 4x4 --pipeline omp --steps 5 --no-state --out " + (dir_ / "o").string(), program.c_str());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("deformlab: note: OMP_NUM_THREADS asks for 100000 threads on ", 0), 0u) << r.err;
+}
+
 // The viewer checks its flags before it opens a window (no display needed for these).
 TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
   for (const auto& [args, error] : std::vector<std::pair<std::string, std::string>>{
