@@ -114,11 +114,17 @@ int main(int argc, char** argv) {
   }
   if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
   deformlab::app::cap_openmp_threads("deformlab");
-  if (*run) return deformlab::app::run_command(a);
-  if (*experiment) return deformlab::app::experiment_command(ex);
-  if (*list) return deformlab::app::list_command();
-  if (*calibrate) return deformlab::app::calibrate_command(cal);
-  if (*view) return deformlab::app::view_command(v);
-  if (*mesh) return deformlab::app::mesh_command(mesh_args);
-  return 2;
+  int code = 2;
+  if (*run) code = deformlab::app::run_command(a);
+  else if (*experiment) code = deformlab::app::experiment_command(ex);
+  else if (*list) code = deformlab::app::list_command();
+  else if (*calibrate) code = deformlab::app::calibrate_command(cal);
+  else if (*view) code = deformlab::app::view_command(v);
+  else if (*mesh) code = deformlab::app::mesh_command(mesh_args);
+  // What a command printed may not have reached its standard output (a full disk, a closed pipe).
+  if (!std::cout.flush()) {
+    std::cerr << "deformlab: error: standard output could not be written (a full disk, a closed pipe?)\n";
+    return code ? code : 1;
+  }
+  return code;
 }

@@ -395,6 +395,7 @@ const std::vector<BadInput>& cases() {
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_unknown_name", "experiment nosuch", "no experiment file or built-in experiment 'nosuch' (built in: "},
       {"run_unknown_experiment", "run --experiment tabel2", "no experiment file or built-in experiment 'tabel2'"},
+      {"report_max_size", "experiment quick --report-only --max-size 4", "--max-size limits the cells a run measures"},
       {"experiment_max_size_zero", "experiment quick --max-size 0", "--max-size: '0' is not in 1 to 1048576"},
       {"experiment_out_is_a_file", "experiment quick --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
       {"experiment_out_under_a_file", "experiment quick --out {dir}/f.txt/sub", "f.txt' is not a folder", {{"f.txt", "x"}}},

@@ -351,6 +351,14 @@ TEST_F(Cli, OpenMpThreadsPastTheHardwareAreCapped) {
   EXPECT_EQ(r.err.rfind("deformlab: note: OMP_NUM_THREADS asks for 100000 threads on ", 0), 0u) << r.err;
 }
 
+// Output that cannot reach standard output is said, exit 1.
+TEST_F(Cli, AFullStandardOutputIsSaid) {
+  const fs::path err = dir_ / "stderr.txt";
+  const int status = std::system((std::string(DEFORMLAB_EXE) + " list >/dev/full 2>" + err.string()).c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1);
+  EXPECT_EQ(slurp(err), "deformlab: error: standard output could not be written (a full disk, a closed pipe?)\n");
+}
+
 // The viewer checks its flags before it opens a window (no display needed for these).
 TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
   for (const auto& [args, error] : std::vector<std::pair<std::string, std::string>>{
