@@ -99,8 +99,8 @@ int experiment_command(const ExperimentArgs& a) {
     } catch (const nlohmann::json::exception& e) {  // a cell is checked as it is read: the manifest
       std::string why = e.what();
       if (const auto end = why.find("] "); why.starts_with("[json.exception.") && end != std::string::npos) why.erase(0, end + 2);
-      throw std::invalid_argument(dir.string() + "/manifest.json holds a value of another kind than the report reads (" + why +
-                                  "): a damaged or edited file; run the experiment into another folder");
+      throw std::invalid_argument("a results file in " + dir.string() + " (its manifest.json, or a cell) holds a value of another kind "
+                                  "than the report reads (" + why + "): a damaged or edited file; run the experiment into another folder");
     }
     std::cout << "report: " << report.string() << "\n";
     return 0;

@@ -72,14 +72,17 @@ constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".de
 fs::path temporary(const fs::path& name) { return name.string().append(kTemporaryTag) + std::to_string(::getpid()); }
 
 void write_atomically(const fs::path& file, const std::string& text) {
+  auto write = [&](const fs::path& to) { write_file(to.string(), [&](std::ostream& out) { out << text; }, true); };
+  std::error_code ec;
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return write(file);  // a pipe, a device: written to
   const fs::path tmp = temporary(file);
   try {
-    write_file(tmp.string(), [&](std::ostream& out) { out << text; }, true);
-  } catch (const std::runtime_error&) {  // named as the file asked for, with the write's reason
-    const int error = errno;
-    std::error_code ec;
+    write(tmp);
+  } catch (const std::runtime_error& e) {  // named as the file asked for
     fs::remove(tmp, ec);
-    throw write_error(file.string(), error);
+    std::string what = e.what();
+    if (const auto at = what.find(tmp.string()); at != std::string::npos) what.replace(at, tmp.string().size(), file.string());
+    throw std::runtime_error(what);
   }
   if (std::rename(tmp.c_str(), file.c_str()) != 0) {
     const int error = errno;
@@ -214,8 +217,10 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
 
 void OutputDir::remove_created() const {
   std::error_code ec;
-  for (const fs::path& p : created_)
+  for (const fs::path& p : created_) {
+    if (!fs::exists(p, ec)) continue;  // not made: creating the folders stopped above it
     if (!fs::is_empty(p, ec) || !fs::remove(p, ec)) return;
+  }
 }
 
 OutputDir::~OutputDir() {

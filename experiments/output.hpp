@@ -41,7 +41,8 @@ std::string foreign_frames_entry(const std::filesystem::path& frames);
 // files are never taken for them.
 std::filesystem::path temporary(const std::filesystem::path& name);
 // Writes `file` whole or not at all: into its temporary, renamed over it once written (on a
-// failure the temporary is removed and write_error thrown).
+// failure the temporary is removed and write_error's words thrown, naming `file`). A file
+// there that is no regular file (a pipe, a device) is written to as it is.
 void write_atomically(const std::filesystem::path& file, const std::string& text);
 // Whether `name` is a temporary's.
 bool is_temporary(const std::string& name);

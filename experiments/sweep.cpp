@@ -249,9 +249,9 @@ std::string cell_problem(const json& c) {
   };
   for (const Key& k : {Key{"id", text, true}, Key{"status", text, true}, Key{"pipeline", text, true},
                        Key{"integrator", text, true}, Key{"options", object, true}, Key{"model", text, false},
-                       Key{"order", text, false}, Key{"reason", text, false}, Key{"method", text, ok},
+                       Key{"order", text, false}, Key{"reason", text, !ok}, Key{"method", text, ok},
                        Key{"step_clock", text, false}, Key{"build", text, false}, Key{"mesh", text, false},
-                       Key{"size", whole, false}, Key{"nodes", whole, false}, Key{"springs", whole, false},
+                       Key{"size", whole, false}, Key{"nodes", whole, ok}, Key{"springs", whole, false},
                        Key{"bandwidth", whole, false}, Key{"chosen_options", object, false},
                        Key{"measurement", object, false}, Key{"sm_clock", {T::object, T::null}, false},
                        Key{"stable", {T::boolean}, false}, Key{"median_ms", real, ok}, Key{"min_ms", real, false},
@@ -262,6 +262,13 @@ std::string cell_problem(const json& c) {
     if (c.contains(k))
       for (const auto& value : c[k])
         if (!value.is_string()) return std::string("its \"") + k + "\" holds a value that is not text";
+  if (c.contains("sm_clock") && c["sm_clock"].is_object()) {  // as ClockSummary writes it
+    const json& k = c["sm_clock"];
+    if (!k.contains("device") || !k["device"].is_string() || !k.contains("slowed_fraction") || !k["slowed_fraction"].is_number())
+      return "its \"sm_clock\" is not a clock summary";
+    for (const char* n : {"samples", "sm_mhz_min", "sm_mhz_median", "sm_mhz_max", "sm_mhz_top", "slowdown_bits"})
+      if (!k.contains(n) || !k[n].is_number_unsigned()) return "its \"sm_clock\" is not a clock summary";
+  }
   for (const json& v : c.contains("samples_ms") ? c["samples_ms"] : json::array())
     if (!v.is_number()) return "its \"samples_ms\" holds a value that is not a number";
   for (const json& st : c.contains("stages") ? c["stages"] : json::array())

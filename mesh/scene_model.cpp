@@ -76,7 +76,8 @@ auto naming(const std::string& what, F&& f) {
 // Refuses a fill whose tetrahedra of `cell_size` would make more than 2^30 nodes, or a model
 // that would not fit, estimated from the volume the surface encloses (before meshing): by the
 // divergence theorem over each connected part's triangles, its magnitude, so that parts wound
-// the other way add rather than cancel (a cavity counts as filled: an upper bound).
+// the other way add rather than cancel (a cavity's volume is added, not taken away: an upper
+// bound).
 void check_fill_size(const Mesh& surface, float cell_size) {
   std::vector<std::int32_t> root(surface.position.size());
   std::iota(root.begin(), root.end(), 0);

@@ -1,7 +1,6 @@
 #include "script.hpp"
 
 #include <cfloat>
-#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -81,14 +80,11 @@ Event from_json(const nlohmann::json& j) {
         throw std::invalid_argument("key '" + e.key + "' is not a key name (a-z, space, backspace)");
     } else if (key == "file") {
       e.file = text(v, key);
-    } else if (key == "dt") {  // set: a number or its text (as a saved script has it), as --dt takes it
-      const std::string t = v.is_string() ? v.get<std::string>() : v.dump();
-      double dt = 0;
-      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), dt);
-      if (!(v.is_number() || v.is_string()) || ec != std::errc() || end != t.data() + t.size() ||
-          !(dt >= double(FLT_MIN) && dt <= double(FLT_MAX)))
+    } else if (key == "dt" && v.is_number()) {  // set: a number as --dt takes it; text, as the panel
+      // records what was typed there, is replayed as typed (and refused, if it is, as the panel did)
+      if (!(v.get<double>() >= double(FLT_MIN) && v.get<double>() <= double(FLT_MAX)))
         throw std::invalid_argument("dt must be a number of seconds > 0 within float's normal range");
-      e.settings[key] = t;
+      e.settings[key] = v.dump();
     } else if (key == "pipeline" && (!v.is_string() || !pipelines().find(v.get<std::string>()))) {
       throw std::invalid_argument(v.is_string() ? "unknown pipeline '" + v.get<std::string>() + "' (valid: " + pipelines().names() + ")"
                                                 : "pipeline must be a string");

@@ -429,7 +429,7 @@ class Viewer {
     try {
       write_atomically(o_.summary, summary_.dump(1) + "\n");
     } catch (const std::runtime_error& e) {
-      std::cerr << "deformlab: error: " << e.what() << "\n";
+      std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
       return 1;
     }
     return 0;

@@ -297,7 +297,10 @@ TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {
   // A bad input into an existing folder touches nothing either.
   EXPECT_EQ(run("run --grid 0x0 --out " + out.string()).code, 2);
   EXPECT_EQ(left(), mine);
-  // Nor does a failed run leave the folders it made for its outputs.
+  // Nor does a failed run leave the folders it made for its outputs, also where making them
+  // stopped partway (a name too long).
+  EXPECT_EQ(run("run --pipeline cpu --grid 4x4 --steps 2 --out " + (out / "new" / std::string(300, 'n')).string()).code, 2);
+  EXPECT_EQ(left(), mine);
   EXPECT_EQ(run("run --pipeline cpu --integrator explicit-euler --grid 8x8 --dt 0.05 --steps 500 --out " +
                 (out / "new" / "sub/").string()).code, 1);
   EXPECT_EQ(left(), mine);
@@ -312,7 +315,12 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   ASSERT_EQ(run(experiment).code, 0);
   const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__4.json";
   const nlohmann::json good = nlohmann::json::parse(slurp(cell));
-  // Each key the report reads is checked (a method of another kind, say).
+  // Each key the report reads is checked (a method of another kind, say, or no node count).
+  nlohmann::json no_nodes = good;
+  no_nodes.erase("nodes");
+  std::ofstream(dir_ / "r" / "cells" / "x.json") << no_nodes.dump();
+  EXPECT_NE(run(experiment + " --report-only").err.find("x.json is not a cell result (its \"nodes\" is missing)"),
+            std::string::npos);
   nlohmann::json no_method = good;
   no_method["method"] = 5;
   std::ofstream(dir_ / "r" / "cells" / "x.json") << no_method.dump();
@@ -336,8 +344,9 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
   const Result damaged = run(experiment + " --report-only");
   EXPECT_EQ(damaged.code, 2);
-  EXPECT_EQ(damaged.err.rfind("deformlab: error: " + (dir_ / "r" / "manifest.json").string() +
-                                  " holds a value of another kind than the report reads (cannot use value() with null)", 0),
+  EXPECT_EQ(damaged.err.rfind("deformlab: error: a results file in " + (dir_ / "r").string() +
+                                  " (its manifest.json, or a cell) holds a value of another kind than the report reads "
+                                  "(cannot use value() with null)", 0),
             0u) << damaged.err;
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
 }

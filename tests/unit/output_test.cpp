@@ -206,6 +206,28 @@ TEST(OutputFiles, AFailedWriteSaysWhy) {
   }
 }
 
+// write_atomically replaces a regular file whole, names that file (not its temporary) when it
+// fails, and writes to what is no regular file (a pipe, a device) as it is.
+TEST(OutputFiles, WrittenWholeOrNotAtAll) {
+  const fs::path dir = fs::temp_directory_path() / ("deformlab-atomic-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_atomically(dir / "a.json", "new");
+  std::ifstream in(dir / "a.json");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "new");
+  fs::create_symlink("/dev/null", dir / "sink");
+  write_atomically(dir / "sink", "x");
+  EXPECT_TRUE(fs::is_symlink(dir / "sink")) << "the link, and the device behind it, stay";
+  try {
+    write_atomically(dir / "none" / "b.json", "x");
+    ADD_FAILURE() << "written";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "none" / "b.json").string() + ": No such file or directory");
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2) << "no temporary left";
+  fs::remove_all(dir);
+}
+
 TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
   const fs::path dir = fresh("deformlab-folder-holds");
   EXPECT_EQ(folder_holds(dir), Holds::nothing);

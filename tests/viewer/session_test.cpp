@@ -132,11 +132,10 @@ TEST(ViewerScript, MistypedEventsAreRefusedByIndex) {
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "move", "x": 1, "y": 1e300})"), at + "y must be a number within ±1e6");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": 1e-40})"),
             at + "dt must be a number of seconds > 0 within float's normal range");
-  EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": "0"})"),
-            at + "dt must be a number of seconds > 0 within float's normal range");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "pipeline": "foo"})").rfind(at + "unknown pipeline 'foo' (valid: ", 0), 0u);
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "integrator": "rk5"})").rfind(at + "unknown integrator 'rk5'", 0), 0u);
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": "0.0005"})"), "") << "a saved script's dt is text";
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": "abc"})"), "") << "as typed into the panel: refused when replayed";
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "press", "shift": 1})"), at + "shift must be true or false");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "screenshot", "file": 3})"), at + "file must be a string");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "key"})"), at + "a key event needs a key");
