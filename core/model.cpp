@@ -95,16 +95,15 @@ Model build_grid(Topology t, int nx, int ny, int nz, float h, const Material& ma
   return m;
 }
 
-// The node count in double: a lattice's can pass what 64 bits hold.
-void check_size(double nodes) {
+}  // namespace
+
+void check_node_count(double nodes) {
   if (nodes > double(std::int64_t(1) << 30))
     throw std::invalid_argument("a model of " + about_nodes(nodes) + " exceeds the limit of 2^30 nodes");
 }
 
-}  // namespace
-
 Model cloth_grid(int nx, int ny, float h, float y0, const Material& mat) {
-  if (nx >= 1 && ny >= 1) check_size(double(nx) * ny);
+  if (nx >= 1 && ny >= 1) check_node_count(double(nx) * ny);
   const float cx = 0.5f * float(nx - 1) * h, cz = 0.5f * float(ny - 1) * h;
   return build_grid(Topology::cloth_grid, nx, ny, 1, h, mat, [&](int i, int j, int) {
     return Vec3f{float(i) * h - cx, y0, float(j) * h - cz};
@@ -112,7 +111,7 @@ Model cloth_grid(int nx, int ny, float h, float y0, const Material& mat) {
 }
 
 Model lattice(int nx, int ny, int nz, float h, float y0, const Material& mat) {
-  if (nx >= 1 && ny >= 1 && nz >= 1) check_size(double(nx) * ny * nz);
+  if (nx >= 1 && ny >= 1 && nz >= 1) check_node_count(double(nx) * ny * nz);
   const float cx = 0.5f * float(nx - 1) * h, cz = 0.5f * float(nz - 1) * h;
   return build_grid(Topology::lattice, nx, ny, nz, h, mat, [&](int i, int j, int k) {
     return Vec3f{float(i) * h - cx, y0 + float(j) * h, float(k) * h - cz};

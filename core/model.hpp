@@ -84,6 +84,10 @@ struct Material {
   float node_mass = 0.01f;  // kg per node
 };
 
+// Throws std::invalid_argument for more than 2^30 nodes (the count in double: a lattice's can
+// pass what 64 bits hold).
+void check_node_count(double nodes);
+
 // Cloth: nx x ny nodes in the x-z plane at height y0, centred on x = z = 0, spacing h.
 // Grid row j = 0 is the "top" row (its corners are the "top corners").
 Model cloth_grid(int nx, int ny, float spacing, float y0, const Material& m);

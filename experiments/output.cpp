@@ -31,12 +31,8 @@ void require_folder_or_nothing(const fs::path& dir) {
 }
 
 json read_manifest(const fs::path& dir) {
-  std::ifstream in(dir / "manifest.json");
-  if (!in) return nullptr;
-  std::ostringstream text;
-  text << in.rdbuf();
   try {
-    return parse_json(text.str(), "manifest.json");  // JSON nested too deep is refused before the tree is built
+    return read_json_file((dir / "manifest.json").string(), "manifest");  // with its checks (nesting, size)
   } catch (const std::invalid_argument&) {
     return nullptr;
   }
@@ -370,9 +366,7 @@ nlohmann::json build_info() {
 
 ModelSize model_size(const ModelSpec& ms) {
   if (ms.topology == Topology::general) throw std::invalid_argument("a mesh's size is known once its file is read");
-  // In double first: a lattice's count can pass what 64 bits hold.
-  if (const double n = double(ms.nx) * ms.ny * ms.nz; n > double(std::int64_t(1) << 30))
-    throw std::invalid_argument("a model of " + about_nodes(n) + " exceeds the limit of 2^30 nodes");
+  check_node_count(double(ms.nx) * ms.ny * ms.nz);
   const auto k = ms.topology == Topology::lattice ? lattice_spring_counts(ms.nx, ms.ny, ms.nz)
                                                   : cloth_spring_counts(ms.nx, ms.ny);
   return {std::int64_t(ms.nx) * ms.ny * ms.nz, k[0] + k[1] + k[2], true};

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/clock_watch.hpp"
 #include "core/json_file.hpp"
 #include "core/run.hpp"
 #include "core/scene.hpp"
@@ -262,13 +263,11 @@ std::string cell_problem(const json& c) {
     if (c.contains(k))
       for (const auto& value : c[k])
         if (!value.is_string()) return std::string("its \"") + k + "\" holds a value that is not text";
-  if (c.contains("sm_clock") && c["sm_clock"].is_object()) {  // as ClockSummary writes it
-    const json& k = c["sm_clock"];
-    if (!k.contains("device") || !k["device"].is_string() || !k.contains("slowed_fraction") || !k["slowed_fraction"].is_number())
+  if (c.contains("sm_clock")) try {
+      clock_summary(c["sm_clock"]);  // as the report reads it
+    } catch (const json::exception&) {
       return "its \"sm_clock\" is not a clock summary";
-    for (const char* n : {"samples", "sm_mhz_min", "sm_mhz_median", "sm_mhz_max", "sm_mhz_top", "slowdown_bits"})
-      if (!k.contains(n) || !k[n].is_number_unsigned()) return "its \"sm_clock\" is not a clock summary";
-  }
+    }
   for (const json& v : c.contains("samples_ms") ? c["samples_ms"] : json::array())
     if (!v.is_number()) return "its \"samples_ms\" holds a value that is not a number";
   for (const json& st : c.contains("stages") ? c["stages"] : json::array())

@@ -122,36 +122,28 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   return m;
 }
 
-// How many of `triangles` are no face of a tetrahedron of `m` (a volume).
+// How many of `triangles` are no face of a tetrahedron of `m` (a volume): the triangles sorted
+// (each by its vertices, then all), each tetrahedron's faces looked up among them.
 std::int64_t triangles_bounding_no_tetrahedron(const Mesh& m, std::vector<std::array<std::int32_t, 3>> triangles) {
-  using Face = std::array<std::int32_t, 3>;
-  struct Hash {
-    std::size_t operator()(const Face& f) const {
-      return std::hash<std::uint64_t>()((std::uint64_t(std::uint32_t(f[0])) << 32 | std::uint32_t(f[1])) ^
-                                        std::uint64_t(std::uint32_t(f[2])) * 0x9e3779b97f4a7c15ull);
-    }
-  };
-  std::unordered_map<Face, std::int64_t, Hash> loose;  // sorted triangle -> how often it is given
-  std::vector<char> on_one(m.position.size());         // the nodes of those triangles
-  for (Face& f : triangles) {
+  std::vector<char> on_one(m.position.size());  // the nodes of the triangles
+  for (auto& f : triangles) {
     std::sort(f.begin(), f.end());
-    ++loose[f];
     for (std::int32_t v : f) on_one[std::size_t(v)] = 1;
   }
-  for (std::size_t t = 0; t < m.tetrahedron.size() && !loose.empty(); ++t) {
-    const auto& tet = m.tetrahedron[t];
-    if (on_one[tet[0]] + on_one[tet[1]] + on_one[tet[2]] + on_one[tet[3]] < 3) continue;  // most: none of its faces
+  std::sort(triangles.begin(), triangles.end());
+  std::vector<char> bounds(triangles.size());
+  for (const auto& t : m.tetrahedron) {
+    if (on_one[t[0]] + on_one[t[1]] + on_one[t[2]] + on_one[t[3]] < 3) continue;  // most: none of its faces
     for (int skip = 0; skip < 4; ++skip) {
-      Face f;
+      std::array<std::int32_t, 3> f;
       for (int c = 0, o = 0; c < 4; ++c)
-        if (c != skip) f[o++] = m.tetrahedron[t][c];
+        if (c != skip) f[o++] = t[c];
       std::sort(f.begin(), f.end());
-      loose.erase(f);
+      const auto [lo, hi] = std::equal_range(triangles.begin(), triangles.end(), f);
+      std::fill(bounds.begin() + (lo - triangles.begin()), bounds.begin() + (hi - triangles.begin()), 1);
     }
   }
-  std::int64_t count = 0;
-  for (const auto& [face, times] : loose) count += times;
-  return count;
+  return std::count(bounds.begin(), bounds.end(), 0);
 }
 
 }  // namespace
