@@ -18,6 +18,8 @@ namespace {
 // - a key given twice in one object (the library keeps the last) and where that object is
 //   ("spheres[1]"): the keys of each object still open, and where each open container sits in
 //   its parent;
+// - a key or string with a NUL character in it, which no name or value needs and which would
+//   cut short any message that quotes it;
 // - arrays and objects nested deeper than kMaxDepth, which the library's tree would copy,
 //   compare and write out by recursion, as deep as the nesting (a stack overflow at 100 000
 //   levels).
@@ -31,28 +33,18 @@ class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
   bool number_integer(number_integer_t) override { return value(); }
   bool number_unsigned(number_unsigned_t) override { return value(); }
   bool number_float(number_float_t, const string_t&) override { return value(); }
-  bool string(string_t&) override { return value(); }
+  bool string(string_t& s) override { return value() && no_nul(s, "a string", open_.size()); }
   bool binary(binary_t&) override { return value(); }
   bool start_object(std::size_t) override { return open(true); }
   bool start_array(std::size_t) override { return open(false); }
   bool end_object() override { return close(); }
   bool end_array() override { return close(); }
   bool key(string_t& k) override {
+    if (!no_nul(k, "a key", open_.size() - 1)) return false;
     Frame& f = open_.back();
     f.key = k;
     if (f.keys.insert(k).second) return true;
-    std::string at;
-    for (std::size_t i = 0; i + 1 < open_.size(); ++i) {
-      if (!open_[i].object) {
-        at += '[';
-        at += std::to_string(open_[i].elements - 1);
-        at += ']';
-        continue;
-      }
-      if (!at.empty()) at += '.';
-      at += open_[i].key;
-    }
-    found = "gives the key '" + k + "' twice in one object" + (at.empty() ? "" : " (at " + at + ")");
+    found = "gives the key '" + k + "' twice in one object" + where(open_.size() - 1);
     return false;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
@@ -67,6 +59,27 @@ class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
   bool value() {
     if (!open_.empty() && !open_.back().object) ++open_.back().elements;
     return true;
+  }
+  // " (at spheres[1].centre)": the place of the value read last, through the first `depth`
+  // containers still open; empty at the top.
+  std::string where(std::size_t depth) const {
+    std::string at;
+    for (std::size_t i = 0; i < depth; ++i) {
+      if (!open_[i].object) {
+        at += '[';
+        at += std::to_string(open_[i].elements - 1);
+        at += ']';
+        continue;
+      }
+      if (!at.empty()) at += '.';
+      at += open_[i].key;
+    }
+    return at.empty() ? "" : " (at " + at + ")";
+  }
+  bool no_nul(const string_t& s, const char* what, std::size_t depth) {
+    if (s.find('\0') == string_t::npos) return true;
+    found = std::string("holds ") + what + " with a NUL character in it" + where(depth);
+    return false;
   }
   bool open(bool object) {
     value();

@@ -239,8 +239,7 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
     if (j.contains("generate") && j.contains(k) && !(k == std::string("fill") && j[k] == "none"))
       bad(where + "." + k, "fills a surface file; a generated mesh takes generate.cell_size");
   if (j.contains("file")) {
-    if (!j["file"].is_string() || j["file"].get<std::string>().empty() || j["file"].get<std::string>().find('\0') != std::string::npos)
-      bad(where + ".file", "expected a file name (without a NUL character)");
+    if (!j["file"].is_string() || j["file"].get<std::string>().empty()) bad(where + ".file", "expected a file name");
     const std::filesystem::path f = j["file"].get<std::string>();
     m.file = (f.is_relative() && !dir.empty() ? std::filesystem::path(dir) / f : f).lexically_normal().string();
     m.generate.reset();

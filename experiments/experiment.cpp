@@ -31,9 +31,8 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
   Experiment x;
   // "base": start from another experiment's scene and settings (a built-in name or a file).
   if (j.contains("base")) {
-    if (!j["base"].is_string() || j["base"].get<std::string>().empty() ||
-        j["base"].get<std::string>().find('\0') != std::string::npos)
-      throw std::invalid_argument(where + ".base: expected an experiment name (without a NUL character)");
+    if (!j["base"].is_string() || j["base"].get<std::string>().empty())
+      throw std::invalid_argument(where + ".base: expected an experiment name");
     if (bases_open == kMaxBases)
       throw std::invalid_argument(where + ".base: more than " + std::to_string(kMaxBases) +
                                   " experiments based on one another (a loop?)");

@@ -122,6 +122,9 @@ const std::vector<BadInput>& cases() {
        "s.json' gives the key 'radius' twice in one object (at spheres[1])",
        {{"s.json", "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}, {\"center\": [0, 1, 0], \"radius\": 1, "
                    "\"radius\": 2}]}"}}},
+      // A NUL would cut short every message that quotes the string or key (mesh_file_nul below).
+      {"scene_nul_in_a_key", "run --scene {dir}/s.json", "s.json' holds a key with a NUL character in it (at spheres[0])",
+       {{"s.json", R"({"spheres": [{"cent\u0000er": [0, 0, 0]}]})"}}},
       {"scene_nested_deep", "run --scene {dir}/s.json", "s.json' nests arrays and objects more than 256 deep",
        {{"s.json", "{\"model\": {\"pins\": " + std::string(100000, '[') + std::string(100000, ']') + "}}"}}},
       // scene values
@@ -366,9 +369,9 @@ const std::vector<BadInput>& cases() {
        {{"x.json", R"({"sweep": 5})"}}},
       {"experiment_base_empty", "run --experiment {dir}/x.json", "x.json.base: expected an experiment name",
        {{"x.json", R"({"base": ""})"}}},
-      {"experiment_base_nul", "run --experiment {dir}/x.json", "x.json.base: expected an experiment name (without a NUL",
+      {"experiment_base_nul", "run --experiment {dir}/x.json", "x.json' holds a string with a NUL character in it (at base)",
        {{"x.json", R"({"base": "paper-drag\u0000x"})"}}},
-      mesh("mesh_file_nul", R"({"file": "m.obj\u0000.txt"})", "s.json.model.file: expected a file name (without a NUL"),
+      mesh("mesh_file_nul", R"({"file": "m.obj\u0000.txt"})", "s.json' holds a string with a NUL character in it (at model.file)"),
       {"experiment_base_loop", "run --experiment {dir}/a.json", "experiments based on one another (a loop?)",
        {{"a.json", R"({"base": "{dir}/b.json"})"}, {"b.json", R"({"base": "{dir}/a.json"})"}}},
       {"experiment_base_unknown", "run --experiment {dir}/x.json",
