@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
+#include "run_input.hpp"
 #include "experiments/output.hpp"
 #if DEFORMLAB_HAVE_INTEROP
 #include "interop/calibrate.hpp"
@@ -33,6 +34,7 @@ nlohmann::json measure_calibration(const std::vector<std::string>& argv) {
 
 int calibrate_command(const CalibrateArgs& a) {
   return report_errors([&] {
+    if (a.out) require_file_target(*a.out, "--out");  // before the measurement, which takes seconds
     const nlohmann::json j = measure_calibration(a.argv);
     if (a.out) {
       write_json(*a.out, j);

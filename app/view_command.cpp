@@ -12,22 +12,6 @@
 #endif
 
 namespace deformlab::app {
-namespace {
-
-// Throws std::invalid_argument where `file`, named by `what`, could not be written: a folder in
-// its place, or no folder to hold it.
-void require_file_target(const std::string& file, const std::string& what) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
-  const fs::path folder = fs::path(file).parent_path();
-  if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
-  if (!folder.empty() && !fs::is_directory(folder, ec))
-    throw std::invalid_argument(what + " '" + file + "': no folder '" + folder.string() + "'");
-}
-
-}  // namespace
-
 int view_command(const ViewArgs& a) {
   return report_errors([&]() -> int {
     // A frame's steps run between the window's events (and signals): the panel goes to 200.
@@ -51,6 +35,9 @@ int view_command(const ViewArgs& a) {
       require_file_target(*file, flag);
       own(*file, flag);
     }
+    if (a.record && std::filesystem::path(*a.record).extension() != ".mp4")
+      throw std::invalid_argument("--record '" + *a.record + "': expected a file name ending in .mp4 (the recording is "
+                                  "H.264 in an MP4 file)");
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;
     o.steps_per_frame = a.steps_per_frame;

@@ -318,6 +318,9 @@ const std::vector<BadInput>& cases() {
        {{"s.json", R"({"model": {"type": "mesh", "file": "t.obj", "fill": "tetrahedra", "pins": "none"}})"},
         {"t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
         {"f.txt", "x"}}},
+      // `deformlab calibrate --out`: checked before the measurement, which takes seconds
+      {"calibrate_out_no_folder", "calibrate --out {dir}/none/c.json", "none/c.json': no folder '"},
+      {"calibrate_out_a_folder", "calibrate --out {dir}", "' is a folder"},
       scene("grid_mesh_key", "{\"model\": {\"file\": \"m.obj\"}}", "s.json.model.file: a key of mesh models"),
       scene("drag_node_box", "{\"drag\": {\"node\": {\"box\": [[0, 0, 0], [1, 1, 1]]}}}",
             "s.json.drag.node: expected a node index, \"center\" or {\"nearest\": [x, y, z]}"),

@@ -372,11 +372,27 @@ TEST_F(Cli, AFullStandardOutputIsSaid) {
 TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
   for (const auto& [args, error] : std::vector<std::pair<std::string, std::string>>{
            {"--steps-per-frame 2147483647", "--steps-per-frame must be in 1 to 10000"},
-           {"--size 200x1 --record " + (dir_ / "x.mp4").string(), "--record needs a window 2 pixels high or more"}}) {
+           {"--size 200x1 --record " + (dir_ / "x.mp4").string(), "--record needs a window 2 pixels high or more"},
+           {"--record " + (dir_ / "x.txt").string(), "--record '" + (dir_ / "x.txt").string() +
+                                                       "': expected a file name ending in .mp4"}}) {
     const Result r = run("view " + args);
     EXPECT_EQ(r.code, 2) << args;
     EXPECT_EQ(r.err.rfind("deformlab: error: " + error, 0), 0u) << r.err;
   }
+}
+
+// --gl-device picks the GPU of a run's OpenGL context: a pipeline with no GL pass makes one only
+// to draw --frames.
+TEST_F(Cli, GlDeviceNeedsAGlPassOrFrames) {
+  const std::string args = "run --pipeline cpu --grid 8x8 --steps 2 --no-state --gl-device 0 --out ";
+  const Result bare = run(args + (dir_ / "bare").string());
+  if (bare.err.find("need a build with OpenGL") != std::string::npos) GTEST_SKIP() << bare.err;
+  EXPECT_EQ(bare.code, 2);
+  EXPECT_EQ(bare.err, "deformlab: error: --gl-device: pipeline 'cpu' runs no OpenGL pass, and no --frames are drawn\n");
+  EXPECT_FALSE(fs::exists(dir_ / "bare"));
+  const Result framed = run(args + (dir_ / "framed").string() + " --frames 2");
+  EXPECT_EQ(framed.code, 0) << framed.err;
+  EXPECT_TRUE(fs::exists(dir_ / "framed" / "frames")) << framed.err;
 }
 
 // deformlab-bench checks a size against the host's memory before it builds the model. Its
