@@ -110,9 +110,10 @@ int main(int argc, char** argv) {
   deformlab::app::decimal_numbers_only(cli);
   if (argc > 1 && std::string(argv[1]) == "help") {
     std::cout << cli.help();
-    return 0;
+    return deformlab::app::flush_output("deformlab", 0);
   }
-  if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
+  if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0)
+    return deformlab::app::flush_output("deformlab", code);  // --help
   deformlab::app::cap_openmp_threads("deformlab");
   int code = 2;
   if (*run) code = deformlab::app::run_command(a);
@@ -121,10 +122,5 @@ int main(int argc, char** argv) {
   else if (*calibrate) code = deformlab::app::calibrate_command(cal);
   else if (*view) code = deformlab::app::view_command(v);
   else if (*mesh) code = deformlab::app::mesh_command(mesh_args);
-  // What a command printed may not have reached its standard output (a full disk, a closed pipe).
-  if (!std::cout.flush()) {
-    std::cerr << "deformlab: error: standard output could not be written (a full disk, a closed pipe?)\n";
-    return code ? code : 1;
-  }
-  return code;
+  return deformlab::app::flush_output("deformlab", code);
 }

@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   deformlab::app::decimal_numbers_only(cli);
   try {
     deformlab::app::cap_openmp_threads("deformlab-bench");  // before parsing: the benches run in its callbacks
-    if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0) return code;
+    // The benches run in the parser's callbacks and print their results as they go.
+    if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0)
+      return deformlab::app::flush_output("deformlab-bench", code);
   } catch (const std::invalid_argument& e) {  // bad input
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 2;
@@ -35,5 +37,5 @@ int main(int argc, char** argv) {
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 1;
   }
-  return 0;
+  return deformlab::app::flush_output("deformlab-bench", 0);
 }

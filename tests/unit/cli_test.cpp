@@ -360,12 +360,19 @@ TEST_F(Cli, OpenMpThreadsPastTheHardwareAreCapped) {
   EXPECT_EQ(r.err.rfind("deformlab: note: OMP_NUM_THREADS asks for 100000 threads on ", 0), 0u) << r.err;
 }
 
-// Output that cannot reach standard output is said, exit 1.
+// Output that cannot reach standard output is said, exit 1: a command's, the help's and the
+// bench's results.
 TEST_F(Cli, AFullStandardOutputIsSaid) {
   const fs::path err = dir_ / "stderr.txt";
-  const int status = std::system((std::string(DEFORMLAB_EXE) + " list >/dev/full 2>" + err.string()).c_str());
-  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1);
-  EXPECT_EQ(slurp(err), "deformlab: error: standard output could not be written (a full disk, a closed pipe?)\n");
+  for (const auto& [program, args] : std::vector<std::pair<std::string, std::string>>{
+           {"deformlab", " list"}, {"deformlab", " help"}, {"deformlab", " run --help"},
+           {"deformlab-bench", " cpu --sizes 8 --reps 1 --warmup 0"}, {"deformlab-bench", " --help"}}) {
+    const std::string exe = program == "deformlab" ? DEFORMLAB_EXE : DEFORMLAB_BENCH_EXE;
+    const int status = std::system((exe + args + " >/dev/full 2>" + err.string()).c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1) << program << args;
+    EXPECT_EQ(slurp(err), program + ": error: standard output could not be written (a full disk, a closed pipe?)\n")
+        << program << args;
+  }
 }
 
 // The viewer checks its flags before it opens a window (no display needed for these).
