@@ -2,6 +2,8 @@
 #pragma once
 #include <cuda_runtime.h>
 
+#include <atomic>
+#include <cstdint>
 #include <string>
 
 namespace deformlab::cuda {
@@ -13,6 +15,9 @@ inline void check(cudaError_t e, const char* what) {
 }
 // After a launch: configuration errors show here, faults in the kernel at the next check.
 inline void check_launch(const char* what) { check(cudaGetLastError(), what); }
+
+// The bytes every Buffer holds now (buffer_bytes() in cuda_pipeline.hpp reads it).
+extern std::atomic<std::int64_t> g_buffer_bytes;
 
 // Device memory owned by one object; freed on destruction.
 template <class T>
@@ -27,9 +32,11 @@ class Buffer {
     if (count == 0) return;
     check(cudaMalloc(reinterpret_cast<void**>(&p_), count * sizeof(T)), what);
     n_ = count;
+    g_buffer_bytes += std::int64_t(count * sizeof(T));
   }
   void release() {
     if (p_) cudaFree(p_);
+    g_buffer_bytes -= std::int64_t(n_ * sizeof(T));
     p_ = nullptr;
     n_ = 0;
   }

@@ -104,6 +104,8 @@ std::string unsupported(Integrator i, Variant v);
 std::int64_t spring_bytes(const ModelSize& m, Variant v);
 // Device memory a pipeline needs, bytes (state, stage slots, model arrays).
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o);
+// Device memory the pipelines' buffers hold now, bytes: what bytes_needed is tested against.
+std::int64_t buffer_bytes();
 // Throws std::invalid_argument naming `what`, the bytes needed and the bytes free when the
 // device does not have `bytes` free.
 void require_device_memory(std::int64_t bytes, const std::string& what);

@@ -13,6 +13,9 @@
 
 namespace deformlab::cuda {
 
+std::atomic<std::int64_t> g_buffer_bytes{0};
+std::int64_t buffer_bytes() { return g_buffer_bytes; }
+
 void fail(cudaError_t e, const std::string& what) {
   throw std::runtime_error("CUDA error while " + what + ": " + cudaGetErrorName(e) + " (" + cudaGetErrorString(e) +
                            ")");

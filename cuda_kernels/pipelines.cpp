@@ -136,8 +136,10 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   b += n * 2 * f4 * s.stage_states;
   const bool one_kernel = (o.variant == Variant::fused || o.variant == Variant::temporal) && s.single_pass();
   if (!one_kernel) b += n * f4 * s.accel_slots;
-  if (s.rule == UpdateRule::verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
-  b += (n / 32 + 1024) * 4 * 2;  // the stop rule's warp maxima (tile padding at most doubles them)
+  const bool verlet = s.rule == UpdateRule::verlet;
+  if (verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
+  const int sets = verlet && o.variant != Variant::temporal ? 3 : 2;
+  b += (sets + 1) * 4;  // the stop rule's largest displacement from each state set, and its result
   return b + spring_bytes(m, o.variant);
 }
 
