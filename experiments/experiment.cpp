@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "core/integrator.hpp"
 #include "core/json_file.hpp"
 
 #include "experiment_files.hpp"
@@ -63,7 +64,12 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       if (!is_plain_name(x.name)) throw std::invalid_argument(where + ".name: " + kPlainName);
     } else if (k == "description") x.description = str();
     else if (k == "pipeline") x.pipeline = str();
-    else if (k == "integrator") x.integrator = str();
+    else if (k == "integrator") {
+      x.integrator = str();
+      if (!parse_integrator(x.integrator))  // also where a sweep names its own: a frame or a run takes this one
+        throw std::invalid_argument(where + ".integrator: unknown integrator '" + x.integrator + "' (valid: " +
+                                    integrator_names() + ")");
+    }
     else if (k == "until_converged") {
       if (!v.is_boolean()) throw std::invalid_argument(where + ".until_converged: expected true or false");
       x.until_converged = v.get<bool>();

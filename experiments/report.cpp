@@ -289,7 +289,9 @@ void write_frames(Report& r) {
     r.md << "None: " << frames.value("unavailable", std::string("?")) << "\n\n";
     return;
   }
-  const json size = frames.value("size", json::array({0, 0}));
+  const json size = frames.value("size", json());
+  if (!size.is_array() || size.size() != 2 || !size[0].is_number_unsigned() || !size[1].is_number_unsigned())
+    throw std::invalid_argument("the manifest's frames.size: expected [width, height], as the experiment writes it");
   r.md << "The experiment's own scene (" << frames.value("nodes", 0) << " nodes) on `"
        << frames.value("pipeline", std::string()) << "`, " << frames.value("integrator", std::string()) << ", a "
        << size[0] << " x " << size[1] << " frame every " << frames.value("every_steps", 0) << " steps of "
@@ -331,8 +333,10 @@ fs::path write_report(const fs::path& dir) {
   std::set<std::string> ids;
   for (const Cell& c : deformlab::cells(sweep)) ids.insert(c.id());
   std::erase_if(cells, [&](const json& c) {
+    // A mesh cell records the order its model took; it is part of the cell's name only where the sweep names orders.
+    const std::string order = sweep.orders.empty() ? "" : c.value("order", std::string());
     const Cell of{c.value("size", 0), c.value("pipeline", std::string()), c.value("integrator", std::string()),
-                  c.value("options", PipelineOptions{}), c.value("model", std::string()), c.value("order", std::string())};
+                  c.value("options", PipelineOptions{}), c.value("model", std::string()), order};
     return !ids.count(of.id()) || (manifest.contains("measurement") && !measured_as(c, manifest["measurement"], sweep));
   });
   Report r{.dir = dir, .manifest = manifest, .sweep = sweep, .cells = std::move(cells)};

@@ -121,6 +121,10 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
       bad(w + "." + k, "unknown key (expected sizes, models, orders, pipelines, integrators, options, warmup, "
                        "steps, repetitions, cell_limit_s, time, frames, paper_table)");
   }
+  // A cell's timed steps live in memory until it ends, and are counted in an int.
+  if (constexpr std::int64_t most = 10'000'000; std::int64_t(s.steps) * s.repetitions > most)
+    bad(w + ".repetitions", std::to_string(s.repetitions) + " batches of " + std::to_string(s.steps) +
+                                " steps: a cell times at most " + std::to_string(most) + " steps");
   if (s.sizes.empty() == s.models.empty()) bad(w, "needs either sizes or models");
   if (!s.orders.empty() && s.models.empty()) bad(w + ".orders", "node orders go with models");
   if (s.pipelines.empty()) bad(w, "needs pipelines");
@@ -242,7 +246,7 @@ std::string cell_problem(const json& c) {
   auto kind = [](const json& v, std::initializer_list<T> kinds) {
     return std::find(kinds.begin(), kinds.end(), v.type()) != kinds.end();
   };
-  const bool ok = c["status"] == "ok";
+  const bool ok = c["status"] == "ok", mesh = c.contains("model");  // a mesh model's cell, else a grid size's
   struct Key {
     const char* name;
     std::initializer_list<T> kinds;
@@ -251,8 +255,8 @@ std::string cell_problem(const json& c) {
   for (const Key& k : {Key{"id", text, true}, Key{"status", text, true}, Key{"pipeline", text, true},
                        Key{"integrator", text, true}, Key{"options", object, true}, Key{"model", text, false},
                        Key{"order", text, false}, Key{"reason", text, !ok}, Key{"method", text, ok},
-                       Key{"step_clock", text, false}, Key{"build", text, false}, Key{"mesh", text, false},
-                       Key{"size", whole, false}, Key{"nodes", whole, ok}, Key{"springs", whole, false},
+                       Key{"step_clock", text, false}, Key{"build", text, false}, Key{"mesh", text, mesh && ok},
+                       Key{"size", whole, !mesh}, Key{"nodes", whole, ok}, Key{"springs", whole, mesh && ok},
                        Key{"bandwidth", whole, false}, Key{"chosen_options", object, false},
                        Key{"measurement", object, false}, Key{"sm_clock", {T::object, T::null}, false},
                        Key{"stable", {T::boolean}, false}, Key{"median_ms", real, ok}, Key{"min_ms", real, false},

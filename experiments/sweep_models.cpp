@@ -30,6 +30,9 @@ std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& whe
       bad(w, "expected {\"name\": ..., \"model\": {...}}");
     const std::string name = e["name"].is_string() ? e["name"].get<std::string>() : "";
     if (!is_plain_name(name)) bad(w + ".name", kPlainName);
+    if (name.find("__") != std::string::npos)
+      bad(w + ".name", "'" + name + "' holds \"__\", which joins the parts of a cell's name (a cell of another model "
+                       "could take the same name)");
     if (!names.insert(name).second) bad(w + ".name", "model '" + name + "' is named twice");
     Scene probe;
     probe.model.topology = Topology::general;

@@ -340,6 +340,7 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   EXPECT_NE(again.out.find("ran 1 cells, kept 0"), std::string::npos) << again.out;
   EXPECT_TRUE(nlohmann::json::parse(slurp(cell))["median_ms"].is_number());
   nlohmann::json manifest = nlohmann::json::parse(slurp(dir_ / "r" / "manifest.json"));
+  const nlohmann::json machine = manifest["machine"];
   manifest["machine"] = nullptr;
   std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
   const Result damaged = run(experiment + " --report-only");
@@ -349,6 +350,38 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
                                   "(cannot use value() with null)", 0),
             0u) << damaged.err;
   EXPECT_EQ(std::count(damaged.err.begin(), damaged.err.end(), '\n'), 1);
+  // The frames' size, which the report indexes, is checked (an empty one read past its end).
+  manifest["machine"] = machine;
+  manifest["frames"] = {{"files", nlohmann::json::array()}, {"size", nlohmann::json::array()}};
+  std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
+  const Result frames = run(experiment + " --report-only");
+  EXPECT_EQ(frames.code, 2);
+  EXPECT_EQ(frames.err, "deformlab: error: the manifest's frames.size: expected [width, height], as the experiment "
+                        "writes it\n");
+}
+
+// A sweep of mesh models that names no node orders: each cell records the order its model took
+// (the file's), and the report finds the cells all the same.
+TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
+  write("x.json", R"({"name": "sheets", "scene": {"model": {"type": "mesh", "pins": "none",
+                          "generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.25}}},
+      "sweep": {"models": [{"name": "s1", "model": {"generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.2}}}],
+                "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+  const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
+  ASSERT_EQ(run(experiment).code, 0);
+  const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__s1.json";
+  const nlohmann::json good = nlohmann::json::parse(slurp(cell));
+  EXPECT_EQ(good["order"], "file");
+  const std::string report = slurp(dir_ / "r" / "report.md");
+  const std::size_t row = report.find("\n| cpu | ");
+  ASSERT_NE(row, std::string::npos) << report;
+  EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(report[row + 9]))) << report;  // a time, not "-"
+  // Its mesh's counts are keys the report reads.
+  nlohmann::json no_springs = good;
+  no_springs.erase("springs");
+  std::ofstream(cell) << no_springs.dump();
+  EXPECT_NE(run(experiment + " --report-only").err.find("is not a cell result (its \"springs\" is missing)"),
+            std::string::npos);
 }
 
 // More OpenMP threads than 4 a hardware thread are capped, with a note (100000 crashed the
