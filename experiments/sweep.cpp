@@ -185,12 +185,20 @@ std::vector<Cell> cells(const Sweep& s) {
   return out;
 }
 
+// Why the experiment's own scene, of `size`, whose frames the sweep draws on the best pipeline
+// for its integrator, does not fit this host's memory, else "".
+std::string frames_shortfall(const Experiment& x, const ModelSize& size) {
+  const Integrator integ = *parse_integrator(x.integrator);
+  return host_memory_shortfall(size, best_pipeline(integ), integ, {});
+}
+
 json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
 #if DEFORMLAB_HAVE_GL
   if (auto why = gl::unavailable_reason(); !why.empty()) return {{"unavailable", "no OpenGL: " + why}};
   const fs::path tmp = temporary(dir / "frames");
   try {
     const Model m = build_model(x.scene);
+    if (auto why = frames_shortfall(x, m.size()); !why.empty()) return {{"unavailable", "does not fit: " + why}};
     Params p = resolve_params(x.scene, m);
     const Integrator integ = *parse_integrator(x.integrator);
     const PipelineEntry& e = best_pipeline(integ);
@@ -331,6 +339,13 @@ void require_same_experiment(const fs::path& dir, const std::string& name) {
 int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
   using clock = std::chrono::steady_clock;
   require_same_experiment(dir, x.name);
+  // The frames' grid is counted before any cell runs (a mesh once it is read, after them).
+  const ModelSpec& own = x.scene.model;
+  const bool sized = own.topology != Topology::general;
+  const bool over_max_size = o.max_size && sized && std::max({own.nx, own.ny, own.nz}) > *o.max_size;
+  if (s.frames > 0 && sized && !over_max_size)
+    if (const auto why = frames_shortfall(x, model_size(own)); !why.empty())
+      throw std::invalid_argument("the experiment's own scene, whose frames its sweep draws (sweep.frames): " + why);
   fs::create_directories(dir / "cells");
   reclaim_temporaries(dir);
   reclaim_temporaries(dir / "cells");
@@ -381,10 +396,8 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   }
   cache = {};
   if (s.frames > 0 && !fs::exists(dir / "frames")) {
-    const ModelSpec& m = x.scene.model;
-    const bool sized = m.topology != Topology::general;
-    if (o.max_size && sized && std::max({m.nx, m.ny, m.nz}) > *o.max_size)
-      manifest["frames"] = {{"unavailable", "the experiment's " + describe(m) + " is over --max-size " +
+    if (over_max_size)
+      manifest["frames"] = {{"unavailable", "the experiment's " + describe(own) + " is over --max-size " +
                                                 std::to_string(*o.max_size) + "; a run without it renders them"}};
     else
       manifest["frames"] = render_frames(x, s, dir);

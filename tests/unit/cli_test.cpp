@@ -435,18 +435,38 @@ TEST_F(Cli, GlDeviceNeedsAGlPassOrFrames) {
   EXPECT_TRUE(fs::exists(dir_ / "framed" / "frames")) << framed.err;
 }
 
-// deformlab-bench checks a size against the host's memory before it builds the model. Its
-// largest cloth, 32768 x 32768 (2^30 nodes), needs 52 GiB for that.
-TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
+// The host's MemAvailable, GiB.
+double available_gib() {
   std::ifstream meminfo("/proc/meminfo");
   std::string key;
   long long kb = 0;
   while (meminfo >> key >> kb && key != "MemAvailable:") meminfo.ignore(64, '\n');
-  if (kb > 50LL << 20) GTEST_SKIP() << "this host has room for the bench's largest cloth";
+  return double(kb) / (1 << 20);
+}
+
+// deformlab-bench checks a size against the host's memory before it builds the model. Its
+// largest cloth, 32768 x 32768 (2^30 nodes), needs 52 GiB for that.
+TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
+  if (available_gib() > 50) GTEST_SKIP() << "this host has room for the bench's largest cloth";
   const Result r = run("cpu --sizes 32768 --reps 1 --warmup 0", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err.rfind("deformlab-bench: error: a 32768 x 32768 cloth needs ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(" of host memory for its model and state; "), std::string::npos) << r.err;
+}
+
+// An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (52 GiB on a
+// CUDA pipeline, 124 on omp) is refused before the first cell, with nothing written.
+TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
+  if (available_gib() > 50) GTEST_SKIP() << "this host has room for the scene";
+  write("x.json", R"({"name": "big-frames", "scene": {"model": {"size": [32768, 32768]}},
+                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2, "frames": 1}})");
+  const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
+  EXPECT_EQ(r.code, 2);
+  const std::string line = r.err.substr(r.err.rfind("deformlab: error: "));
+  EXPECT_EQ(line.rfind("deformlab: error: the experiment's own scene, whose frames its sweep draws (sweep.frames): a "
+                       "model of 1073741824 nodes on ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r"));
 }
 
 // cuda-temporal holds steps until a launch can take k of them; a check flushes what it holds,
