@@ -84,7 +84,10 @@ inline constexpr const char* kRunColumns = ",scene,integrator,build";
 inline constexpr const char* kBuildColumn = ",build";
 std::string run_columns(const BenchOptions& o);
 std::string build_column();
+// A CSV file to write the rows into, with its header; the file itself is replaced only by
+// finish_csv_files(true), once the bench has ended well (bad input found partway leaves it).
 std::ofstream open_csv(const std::string& path, const char* header, const char* tail);
+void finish_csv_files(bool keep);
 
 // What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.
 struct StepOptions : BenchOptions {

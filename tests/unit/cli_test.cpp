@@ -454,6 +454,22 @@ TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
   EXPECT_NE(r.err.find(" of host memory for its model and state; "), std::string::npos) << r.err;
 }
 
+// deformlab-bench's --csv file is replaced once the bench has ended well: bad input found
+// partway (a size past the node limit, after a smaller size ran) leaves the old file.
+TEST_F(Cli, BenchReplacesItsCsvOnlyWhenItEndsWell) {
+  const fs::path csv = dir_ / "old.csv";
+  std::ofstream(csv) << "precious,data\n";
+  const std::string args = "cpu --reps 2 --warmup 0 --csv " + csv.string() + " --sizes 8";
+  const Result bad = run(args + " 100000", DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_EQ(slurp(csv), "precious,data\n");
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find("old.csv."), std::string::npos) << e.path();  // no temporary left
+  const Result good = run(args, DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(good.code, 0) << good.err;
+  EXPECT_EQ(slurp(csv).rfind("grid,nodes,pipeline,median_ms", 0), 0u) << slurp(csv);
+}
+
 // An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (52 GiB on a
 // CUDA pipeline, 124 on omp) is refused before the first cell, with nothing written.
 TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
