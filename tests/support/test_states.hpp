@@ -70,7 +70,7 @@ testing::AssertionResult within_rounding(const State& g, const State& a, const R
 bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
 bool bitwise_equal(const State& a, const State& b);
 
-// Runs `steps` steps of a pipeline made by `make` from state `s0` and returns the state.
+// Runs `steps` steps of pipeline `p` from state `s0` and returns the state.
 State advance(Pipeline& p, const State& s0, int steps);
 
 // Runs `steps` steps from `s0` with a profiler sampling one window of steps in `every`
