@@ -18,6 +18,7 @@
 #include "core/frame_files.hpp"
 #include "core/json_file.hpp"
 #include "core/write_error.hpp"
+#include "mesh/load.hpp"
 
 namespace deformlab {
 
@@ -361,7 +362,8 @@ nlohmann::json build_info() {
                         std::to_string(EIGEN_MINOR_VERSION)},
           {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
                                 std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
-                                std::to_string(NLOHMANN_JSON_VERSION_PATCH)}};
+                                std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
+          {"mesh_libraries", mesh_library_versions()}};
 }
 
 ModelSize model_size(const ModelSpec& ms) {

@@ -28,7 +28,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 // Throws std::invalid_argument when Gmsh cannot fill it, WriteError when it cannot write it.
 Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to = {});
 
-// The library versions, for manifests.
+// The mesh libraries' versions, "assimp 5.2.5, Gmsh 4.11.1", for manifests (build_info).
 std::string mesh_library_versions();
 
 }  // namespace deformlab

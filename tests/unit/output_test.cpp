@@ -35,6 +35,15 @@ std::string read(const fs::path& f) {
 const std::vector<std::string> kOutputs = {"summary.txt", "state.ply", "trace.json", "frames/"};
 const std::vector<std::string> kWrites = {"summary.txt", "state.ply"};  // what the tests' outputs write
 
+// A manifest's build names the libraries a result depends on, the mesh libraries among them
+// (a mesh read by another assimp or meshed by another Gmsh may have other nodes).
+TEST(BuildInfo, NamesTheMeshLibrariesVersions) {
+  const std::string libs = build_info()["mesh_libraries"];
+  EXPECT_EQ(libs.rfind("assimp ", 0), 0u) << libs;
+  EXPECT_NE(libs.find(", Gmsh 4."), std::string::npos) << libs;
+  EXPECT_EQ(libs.find("0.0.0"), std::string::npos) << libs;
+}
+
 TEST(OutputDir, AnEntryInTheWayIsRefusedBeforeAnythingChanges) {
   const fs::path dir = fresh("deformlab-commit-in-the-way");
   fs::create_directories(dir / "state.ply");  // a folder where the output writes a file
