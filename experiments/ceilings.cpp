@@ -77,6 +77,11 @@ json read_calibration(const std::filesystem::path& file) {
       throw std::invalid_argument(at + "." + m.key + ": expected a number from " + range.str());
     }
   }
+  // What the report names beside the ceilings: the device and where the compute-shader copy ran.
+  if (j.contains("device") && (!j["device"].is_object() || (j["device"].contains("name") && !j["device"]["name"].is_string())))
+    throw std::invalid_argument(file.string() + ".device: expected an object whose \"name\" is text");
+  if (j.contains("compute_copy") && j["compute_copy"].contains("memory") && !j["compute_copy"]["memory"].is_string())
+    throw std::invalid_argument(file.string() + ".compute_copy.memory: expected text (gl or cuda)");
   if (!ceilings_of(j).any())
     throw std::invalid_argument(file.string() +
                                 ": no ceilings in it (copy.GB_per_s, compute_copy.GB_per_s, "

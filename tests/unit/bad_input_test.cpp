@@ -428,6 +428,13 @@ const std::vector<BadInput>& cases() {
        {{"c.json", R"({"copy": {"GB_per_s": 3000}, "floor": {"us_per_hand_off": -4}})"}}},
       {"calibration_not_an_object", "experiment quick --calibration {dir}/c.json", "c.json.copy: expected an object",
        {{"c.json", R"({"copy": 3000})"}}},
+      // The report names these: a results folder's calibration they would break is refused before it is kept.
+      {"calibration_device_text", "experiment quick --report-only --calibration {dir}/c.json --out {dir}/r",
+       "c.json.device: expected an object whose \"name\" is text",
+       {{"c.json", R"({"copy": {"GB_per_s": 100}, "device": "H100"})"}}},
+      {"calibration_memory_number", "experiment quick --calibration {dir}/c.json",
+       "c.json.compute_copy.memory: expected text (gl or cuda)",
+       {{"c.json", R"({"copy": {"GB_per_s": 100}, "compute_copy": {"GB_per_s": 50, "memory": 7}})"}}},
       {"calibration_list", "experiment quick --calibration {dir}/c.json", "not a JSON object", {{"c.json", "[1, 2]"}}},
       {"calibration_empty", "experiment quick --calibration {dir}/c.json", "no ceilings in it",
        {{"c.json", "{\"copy\": {\"device\": \"none\"}}"}}},
