@@ -64,6 +64,16 @@ void record_earlier_measurements(const fs::path& dir, const json& old, const Exp
   }
 }
 
+void require_report_targets(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if ((is_report_file(name) || name == "manifest.json") && !e.is_regular_file(ec))
+      throw std::invalid_argument("results folder '" + dir.string() + "' holds '" + name +
+                                  "', where the experiment writes a file: move it or give another --out");
+  }
+}
+
 void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep& s) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return;
@@ -79,6 +89,7 @@ void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep&
       if (is_report_file(name) || name == "frames" || name == "manifest.json")
         refuse(name, "which no experiment wrote there");
     }
+  require_report_targets(dir);
   for (const char* folder : {"cells", "frames"})
     if (fs::exists(fs::symlink_status(dir / folder, ec)) && !fs::is_directory(fs::symlink_status(dir / folder, ec)))
       refuse(folder, "where the experiment writes a folder");
@@ -90,6 +101,7 @@ void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep&
     if (is_temporary(name)) continue;  // a killed run's, reclaimed by the next
     if (f.path().extension() != ".json" || (!ids.count(name) && read_cell(f.path()).is_null()))
       refuse("cells/" + name, "which is not a cell result");
+    if (!f.is_regular_file(ec)) refuse("cells/" + name, "where the experiment writes a cell's file");
   }
   if (frames_kept(dir, old, x, s)) return;
   if (const std::string e = foreign_frames_entry(dir / "frames"); !e.empty()) refuse("frames/" + e, "which no run writes there");

@@ -37,7 +37,12 @@ void record_earlier_measurements(const std::filesystem::path& dir, const nlohman
 // names none), a report, plot, manifest.json or frames/ of its own, or a file in cells/ that is
 // not a cell result; in one that does, a file in cells/ that is neither a cell result nor named
 // as one of the sweep's cells, or, where the frames are to be rendered again, an entry of
-// frames/ that no run writes.
+// frames/ that no run writes; in either, what is not a file where a cell's file, the report, a
+// plot or manifest.json goes.
 void require_sweep_folder(const std::filesystem::path& dir, const Experiment& x, const Sweep& s);
+// Throws std::invalid_argument where `dir` holds something other than a file (a folder, say) in
+// the place of its report, a plot or manifest.json (require_sweep_folder checks it too; so does
+// --report-only, which writes only those).
+void require_report_targets(const std::filesystem::path& dir);
 
 }  // namespace deformlab

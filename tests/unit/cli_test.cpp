@@ -360,6 +360,30 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
                         "writes it\n");
 }
 
+// A folder where an experiment writes a file (a cell's, the report) is refused before any cell
+// runs, and by --report-only, which writes the report.
+TEST_F(Cli, AFolderInAResultFilesPlaceIsRefusedFirst) {
+  write("x.json", R"({"name": "tiny", "scene": {"model": {"size": [4, 4]}, "drag": null},
+                      "sweep": {"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+  const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
+  ASSERT_EQ(run(experiment).code, 0);
+  const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__5.json";
+  fs::remove(cell);
+  fs::create_directory(cell);
+  const Result r = run(experiment);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "deformlab: error: results folder '" + (dir_ / "r").string() +
+                       "' holds 'cells/cpu__semi-implicit-euler__5.json', where the experiment writes a cell's file: "
+                       "move it or give another --out\n");
+  EXPECT_EQ(r.out.find("[1/2]"), std::string::npos) << r.out;
+  fs::remove(cell);
+  fs::remove(dir_ / "r" / "report.md");
+  fs::create_directory(dir_ / "r" / "report.md");
+  const Result report = run(experiment + " --report-only");
+  EXPECT_EQ(report.code, 2);
+  EXPECT_NE(report.err.find("holds 'report.md', where the experiment writes a file"), std::string::npos) << report.err;
+}
+
 // A sweep of mesh models that names no node orders: each cell records the order its model took
 // (the file's), and the report finds the cells all the same.
 TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
