@@ -23,6 +23,10 @@ int experiment_command(const ExperimentArgs& a) {
     x = load_experiment_by_name(a.file);
     sweep = parse_sweep(x.raw, a.file);
     if (!sweep) throw std::invalid_argument(a.file + ": has no \"sweep\" (run it with `deformlab run --experiment`)");
+    // A results folder is told apart from another experiment's by the name its manifest records.
+    if (x.name.empty())
+      throw std::invalid_argument(a.file + ": has no \"name\", and its file name is not one (" + kPlainName +
+                                  "): give it a \"name\"");
     if (!sweep->sizes.empty() && x.scene.model.topology == Topology::general)
       throw std::invalid_argument(a.file + ".sweep.sizes: the scene's model is a mesh, whose file or \"generate\" gives its size (sweep \"models\")");
     if (a.max_size && !sweep->models.empty()) throw std::invalid_argument("--max-size: this sweep has models, not grid sizes");
@@ -35,7 +39,7 @@ int experiment_command(const ExperimentArgs& a) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
   }
-  const std::filesystem::path dir = a.out ? *a.out : "runs/" + (x.name.empty() ? std::string("experiment") : x.name);
+  const std::filesystem::path dir = a.out ? *a.out : "runs/" + x.name;
   nlohmann::json calibration;
   try {
     require_folder_or_nothing(dir);
