@@ -22,13 +22,16 @@ const char* to_string(SceneKind k);
 std::string describe(SceneKind k);
 
 struct BenchScene {
-  BenchScene(int n, SceneKind k);
+  // Refused (std::invalid_argument) where the model and a state do not fit the host's memory,
+  // beside the largest host footprint of the `pipelines` named (run with `integ`) where given.
+  BenchScene(int n, SceneKind k, const std::vector<std::string>& pipelines = {},
+             Integrator integ = Integrator::semi_implicit_euler);
   Model model;
   Params params;
   PipelineSetup setup(Integrator i) const { return {model, params, i}; }
 
  private:
-  explicit BenchScene(const Scene& s);
+  BenchScene(const Scene& s, const std::vector<std::string>& pipelines, Integrator integ);
 };
 
 // Median and spread of a list of timings (ms), and the GPU's clock while they were taken.

@@ -17,6 +17,7 @@
 #include "core/write_error.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
+#include "experiments/pipelines.hpp"
 #include "mesh/scene_model.hpp"
 
 namespace deformlab::bench {
@@ -48,26 +49,31 @@ Scene scene_of(int n, SceneKind k) {
 }
 }  // namespace
 
-BenchScene::BenchScene(int n, SceneKind k) : BenchScene(scene_of(n, k)) {}
+BenchScene::BenchScene(int n, SceneKind k, const std::vector<std::string>& pipelines, Integrator integ)
+    : BenchScene(scene_of(n, k), pipelines, integ) {}
 
 namespace {
 
-// The scene, once its model and a state are known to fit beside what the host has left (the
-// pipelines' own memory is not counted: an allocation of theirs that fails is reported as out of
-// memory).
-const Scene& fitting(const Scene& s) {
+// The scene, once its model and a state are known to fit beside what the host has left, with
+// the largest host footprint of the pipelines named (an allocation of another pipeline's that
+// fails is reported as out of memory).
+const Scene& fitting(const Scene& s, const std::vector<std::string>& names, Integrator integ) {
   const ModelSize size = model_size(s.model);
   const std::int64_t need = model_host_bytes(size) + state_host_bytes(size.nodes);
   if (const auto limit = host_memory_limit(); limit && need > limit->bytes)
     throw std::invalid_argument("a " + std::to_string(s.model.nx) + " x " + std::to_string(s.model.ny) + " cloth needs " +
                                 gib(need) + " of host memory for its model and state; " + limit->name + " leaves " +
                                 gib(limit->bytes));
+  for (const std::string& name : names)
+    if (const std::string why = host_memory_shortfall(size, *pipelines().find(name), integ, {}); !why.empty())
+      throw std::invalid_argument(why);
   return s;
 }
 
 }  // namespace
 
-BenchScene::BenchScene(const Scene& s) : model(build_model(fitting(s))), params(resolve_params(s, model)) {}
+BenchScene::BenchScene(const Scene& s, const std::vector<std::string>& pipelines, Integrator integ)
+    : model(build_model(fitting(s, pipelines, integ))), params(resolve_params(s, model)) {}
 
 Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};

@@ -494,6 +494,16 @@ TEST_F(Cli, BenchReplacesItsCsvOnlyWhenItEndsWell) {
   EXPECT_EQ(slurp(csv).rfind("grid,nodes,pipeline,median_ms", 0), 0u) << slurp(csv);
 }
 
+// The cpu bench counts its pipelines' own host memory too: an 18000 x 18000 cloth's model and
+// state take 15.7 GiB, with the cpu pipeline's buffers 37.4 (the kernel had killed it).
+TEST_F(Cli, BenchCountsItsPipelinesHostMemory) {
+  if (available_gib() > 37 || available_gib() < 16) GTEST_SKIP() << "this host's memory is not between the two needs";
+  const Result r = run("cpu --sizes 18000 --reps 1 --warmup 0", DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("deformlab-bench: error: a model of 324000000 nodes on cpu needs 37.4 GiB of host memory", 0), 0u)
+      << r.err;
+}
+
 // An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (52 GiB on a
 // CUDA pipeline, 124 on omp) is refused before the first cell, with nothing written.
 TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
