@@ -1,5 +1,5 @@
 // The CUDA pipeline: device buffers, the schedule's passes as kernel launches, step graphs
-// and the device reductions (displacement, energy); and its force pass on its own, the CUDA
+// and the device reduction of the displacement; and its force pass on its own, the CUDA
 // stage of the hybrid pipelines. One translation unit: kernels.cuh and temporal.cuh define the
 // kernels, force_kernels.cuh the model on the device and the force pass. It is compiled once
 // per math mode (core/pipeline.hpp, Math) into namespace DL_CUDA_MATH.
@@ -18,7 +18,6 @@
 #include <stdexcept>
 
 #include "check.cuh"
-#include "energy.cuh"
 #include "event_spans.hpp"
 #include "cuda_pipeline.hpp"
 #include "force_kernels.cuh"
@@ -222,13 +221,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   std::map<std::string, std::string> chosen_options() const override { return chosen_; }
-
-  Energy energy() override {
-    flush();
-    if (!model_.grid() && !springs_.get() && model_.spring_count() > 0) upload_springs();
-    return model_energy(stream_, model_, step_params<double>(model_, p_), sp_, stencil_, springs_.get(),
-                        x_[cur_].get(), v_[cur_].get());
-  }
 
   void set_profiler(Profiler* p) override {
     spans_.collect(prof_);

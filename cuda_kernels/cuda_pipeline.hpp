@@ -6,7 +6,6 @@
 #include <optional>
 #include <string>
 
-#include "core/energy.hpp"
 #include "core/pipeline.hpp"
 
 struct float4;
@@ -69,8 +68,6 @@ struct Options {
 
 class CudaPipeline : public Pipeline {
  public:
-  // Kinetic, spring and field energy of the current state, reduced on the device.
-  virtual Energy energy() = 0;
   // Queues on `stream`, after the steps queued so far, a device copy of the current positions
   // (a float4 per node, w: inverse mass) to `dst`, device memory of the pipeline's device.
   virtual void copy_positions(float4* dst, CUstream_st* stream) = 0;
