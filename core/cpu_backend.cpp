@@ -103,7 +103,8 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
   V springs(const Slot& s, int i) const {
     V f{};
     if (m_.grid()) {
-      const int ci = i % sp_.nx, cj = (i / sp_.nx) % sp_.ny, ck = i / (sp_.nx * sp_.ny);
+      const int ci = P::grid_axis(i, 1, sp_.nx), cj = P::grid_axis(i, sp_.nx, sp_.ny),
+                ck = P::grid_axis(i, sp_.nx * sp_.ny, sp_.nz);
       for (const auto& e : stencil_) {
         const int j = P::grid_neighbour(sp_, ci, cj, ck, e.di, e.dj, e.dk);
         if (j >= 0) f += P::spring_force(s.x[i], s.x[j], s.v[i], s.v[j], e.k, e.kd, e.rest);

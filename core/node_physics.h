@@ -65,6 +65,9 @@ struct StencilEntry {
 };
 
 DL_FN int grid_node(int i, int j, int k, int nx, int ny) { return (k * ny + j) * nx + i; }
+// Node n's coordinate along one axis, grid_node inverted: i = grid_axis(n, 1, nx),
+// j = grid_axis(n, nx, ny), k = grid_axis(n, nx * ny, nz).
+DL_FN int grid_axis(int n, int stride, int size) { return (n / stride) % size; }
 
 // Node (i, j, k) + (di, dj, dk), or -1 when that lies outside the grid.
 DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj, int dk) {

@@ -7,8 +7,12 @@
 #include <cstdint>
 
 #include "model.hpp"
+#include "physics.hpp"
 
 namespace deformlab {
+
+// A grid's index maths (core/node_physics.h), the same for every precision.
+using Grid = Physics<float>;
 
 struct SpringRef {
   int i, j;  // end nodes, i < j
@@ -33,7 +37,7 @@ void for_each_spring(const Model& m, F&& f) {
           const GridOffset o = grid_offset(m.volume(), e);
           const int a = i + o.di, b = j + o.dj, c = k + o.dk;
           if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
-          const int u = (k * m.ny + j) * m.nx + i, v = (c * m.ny + b) * m.nx + a;
+          const int u = Grid::grid_node(i, j, k, m.nx, m.ny), v = Grid::grid_node(a, b, c, m.nx, m.ny);
           f(SpringRef{std::min(u, v), std::max(u, v), grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind],
                       SpringKind(o.kind)});
         }
@@ -50,12 +54,12 @@ void for_each_link(const Model& m, int v, F&& f) {
     }
     return;
   }
-  const int i = v % m.nx, j = (v / m.nx) % m.ny, k = v / (m.nx * m.ny);
+  const int i = Grid::grid_axis(v, 1, m.nx), j = Grid::grid_axis(v, m.nx, m.ny), k = Grid::grid_axis(v, m.nx * m.ny, m.nz);
   for (int e = 0; e < grid_stencil_size(m.volume()); ++e) {
     const GridOffset o = grid_offset(m.volume(), e);
     const int a = i + o.di, b = j + o.dj, c = k + o.dk;
     if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
-    f((c * m.ny + b) * m.nx + a, grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind]);
+    f(Grid::grid_node(a, b, c, m.nx, m.ny), grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind]);
   }
 }
 

@@ -389,7 +389,7 @@ __global__ void scatter_grid(StepParams s, Stencil st, const float4* __restrict_
   const std::int64_t t = thread_index();
   if (t >= std::int64_t(s.node_count) * (N / 2)) return;
   const int u = int(t / (N / 2)), e = N / 2 + int(t % (N / 2));
-  const int i = u % s.nx, j = (u / s.nx) % s.ny, k = u / (s.nx * s.ny);
+  const int i = P::grid_axis(u, 1, s.nx), j = P::grid_axis(u, s.nx, s.ny), k = P::grid_axis(u, s.nx * s.ny, s.nz);
   const P::StencilEntry& o = st.e[e];
   const int w = P::grid_neighbour(s, i, j, k, o.di, o.dj, o.dk);
   if (w < 0) return;

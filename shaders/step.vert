@@ -19,8 +19,8 @@ vec4 forces_acc(int i) { return texelFetch(u_forces_acc, i); }
 
 #ifdef TOPOLOGY_GRID
 ivec3 node_cell(int i) {
-  int layer = params.nx * params.ny, k = STENCIL_SIZE > 12 ? i / layer : 0, r = i - k * layer, j = r / params.nx;
-  return ivec3(r - j * params.nx, j, k);
+  return ivec3(grid_axis(i, 1, params.nx), grid_axis(i, params.nx, params.ny),
+               grid_axis(i, params.nx * params.ny, params.nz));
 }
 #endif
 

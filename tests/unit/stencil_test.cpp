@@ -62,13 +62,14 @@ TEST(GridStencil, BuildersSpringsAreTheStencilsInBoundsPairs) {
     ASSERT_EQ(g.spring_count(), m.spring_count());
     const bool wide = m.nx >= 5 && m.ny >= 5 && (!m.volume() || m.nz >= 5);
     for (int v = 0; v < m.node_count(); ++v) {
-      const int i = v % m.nx, j = (v / m.nx) % m.ny, k = v / (m.nx * m.ny);
+      const int i = Grid::grid_axis(v, 1, m.nx), j = Grid::grid_axis(v, m.nx, m.ny),
+                k = Grid::grid_axis(v, m.nx * m.ny, m.nz);
       std::vector<std::tuple<int, int, float>> by_stencil, by_springs;  // other node, kind, rest length
       for (int e = 0; e < grid_stencil_size(m.volume()); ++e) {
         const GridOffset o = grid_offset(m.volume(), e);
         const int a = i + o.di, b = j + o.dj, c = k + o.dk;
         if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
-        by_stencil.emplace_back((c * m.ny + b) * m.nx + a, o.kind, grid_rest_length(m, o));
+        by_stencil.emplace_back(Grid::grid_node(a, b, c, m.nx, m.ny), o.kind, grid_rest_length(m, o));
       }
       std::vector<std::tuple<int, float, float>> by_links;  // other node, rest length, k
       for_each_link(m, v, [&](int w, float rest, float k, float) { by_links.emplace_back(w, rest, k); });
