@@ -3,7 +3,6 @@
 #include <stdexcept>
 
 #include "commands.hpp"
-#include "run_input.hpp"
 #include "experiments/output.hpp"
 #if DEFORMLAB_HAVE_INTEROP
 #include "interop/calibrate.hpp"

@@ -184,16 +184,6 @@ void require_writable(const std::filesystem::path& out) {
   if (::access(at.c_str(), W_OK) != 0) throw BadInput(folder + ": '" + at.string() + "' is not writable");
 }
 
-void require_file_target(const std::string& file, const std::string& what) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (file.empty()) throw BadInput(what + ": an empty file name");
-  const fs::path folder = fs::path(file).parent_path();
-  if (fs::is_directory(file, ec)) throw BadInput(what + " '" + file + "' is a folder");
-  if (!folder.empty() && !fs::is_directory(folder, ec))
-    throw BadInput(what + " '" + file + "': no folder '" + folder.string() + "'");
-}
-
 namespace {
 
 void check_disk_fits(const RunArgs& a, const RunInput& in) {
@@ -249,9 +239,8 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   in.entry = find_pipeline(in.x, in.integ);
   in.options = parse_options(a.options, *in.entry);
   require_runs(in.entry, in.x, in.integ);
-  const auto gl = [](Engine e) { return e == Engine::gl_compute || e == Engine::gl_transform_feedback; };
-  if (a.gl_device && output == Output::folder && !a.frames && !gl(in.entry->traits.force) &&
-      !gl(in.entry->traits.update))
+  if (a.gl_device && output == Output::folder && !a.frames && !is_gl(in.entry->traits.force) &&
+      !is_gl(in.entry->traits.update))
     throw BadInput("--gl-device: pipeline '" + in.entry->name + "' runs no OpenGL pass, and no --frames are drawn");
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "commands.hpp"
+#include "experiments/output.hpp"
 #include "run_input.hpp"
 #if DEFORMLAB_HAVE_VIEWER
 #include "core/scene.hpp"

@@ -2,8 +2,9 @@
 // run the same scene (BenchScene) and take the same basic flags (BenchOptions).
 #pragma once
 #include <CLI/CLI.hpp>
-#include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/clock_watch.hpp"
@@ -87,9 +88,23 @@ inline constexpr const char* kRunColumns = ",scene,integrator,build";
 inline constexpr const char* kBuildColumn = ",build";
 std::string run_columns(const BenchOptions& o);
 std::string build_column();
-// A CSV file to write the rows into, with its header; the file itself is replaced only by
-// finish_csv_files(true), once the bench has ended well (bad input found partway leaves it).
-std::ofstream open_csv(const std::string& path, const char* header, const char* tail);
+// The rows of a CSV file (none: no file), kept in memory: the file is written whole by
+// finish_csv_files(true) once the bench has ended well, so that bad input found partway, a
+// failure or a kill leave the file as it was.
+class CsvFile : public std::ostringstream {
+ public:
+  CsvFile() = default;
+  explicit CsvFile(std::string file) : file_(std::move(file)) {}
+  CsvFile(CsvFile&& o) noexcept : std::ostringstream(std::move(o)), file_(std::exchange(o.file_, {})) {}
+  ~CsvFile() override;  // hands the rows on to finish_csv_files
+  explicit operator bool() const { return !file_.empty(); }  // whether rows are wanted
+
+ private:
+  std::string file_;
+};
+// The file, which must be writable where it is named (else std::invalid_argument), with its header.
+CsvFile open_csv(const std::string& path, const char* header, const char* tail);
+// Writes each file whose CsvFile is gone (keep), or drops them; throws where one cannot be written.
 void finish_csv_files(bool keep);
 
 // What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.

@@ -13,7 +13,7 @@ namespace {
 void run_cpu(const StepOptions& o) {
   const Integrator integ = o.integ();
   const SceneKind kind = o.scene_kind();
-  std::ofstream csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms", kRunColumns);
+  CsvFile csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms", kRunColumns);
   std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "method: host steady_clock around each step, " << counted(o.warmup, "warm-up step") << ", median of "

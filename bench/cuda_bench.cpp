@@ -52,9 +52,9 @@ struct Row {
 class Report {
  public:
   // `csv`: open_csv_of's, opened before anything is measured.
-  Report(double copy_gbs, std::string bus, std::ofstream csv)
+  Report(double copy_gbs, std::string bus, CsvFile csv)
       : copy_gbs_(copy_gbs), bus_(std::move(bus)), csv_(std::move(csv)) {}
-  static std::ofstream open_csv_of(const CudaOptions& o) {
+  static CsvFile open_csv_of(const CudaOptions& o) {
     return open_csv(o.csv, "table,scene,grid,nodes,variant,integrator,tile,math,steps_per_launch,graphs,median_ms,"
                            "floor_bytes_per_node,effective_GBps,fraction_of_copy,sm_mhz_median,slowed_fraction",
                     kBuildColumn);
@@ -128,7 +128,7 @@ class Report {
   double copy_gbs_;
   std::string bus_;
   ClockTally clocks_;
-  std::ofstream csv_;
+  CsvFile csv_;
 };
 
 void run_cuda(const CudaOptions& o) {
@@ -142,7 +142,7 @@ void run_cuda(const CudaOptions& o) {
   // Asked of a machine without CUDA: refused like deformlab's CUDA pipelines there (exit 2).
   if (const std::string why = cuda::unavailable(); !why.empty()) throw std::invalid_argument(why);
 
-  std::ofstream csv = Report::open_csv_of(o);
+  CsvFile csv = Report::open_csv_of(o);
   const cuda::DeviceInfo dev = cuda::device_info();
   const std::int64_t copy_bytes = std::int64_t(o.copy_mib) << 20;
   const TimedWork copy_work = cuda::time_copy(copy_bytes, 20, o.warmup_ms);

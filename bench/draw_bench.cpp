@@ -24,7 +24,7 @@ const char* to_string(Route r) {
 void run_draw(const StepOptions& o) {
   const gl::ContextInfo& ctx = gl::context();
   const Integrator integ = o.integ();
-  std::ofstream csv =
+  CsvFile csv =
       open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms,sm_mhz_median,slowed_fraction", kRunColumns);
   std::cout << title("draw") << " GL " << ctx.renderer << "; cloth n x n, " << describe(o.scene_kind())
             << ", drawn 1280 x 800 as a surface.\n"

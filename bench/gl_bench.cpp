@@ -148,7 +148,7 @@ void run_gl(const StepOptions& o) {
   const Integrator integ = o.integ();
   const gl::ContextInfo& ctx = gl::context();
   const SceneKind kind = o.scene_kind();
-  std::ofstream csv =
+  CsvFile csv =
       open_csv(o.csv, "device,grid,nodes,what,median_ms,min_ms,p90_ms,sm_mhz_median,slowed_fraction", kRunColumns);
   std::cout << title("gl") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"

@@ -72,7 +72,7 @@ void run_hybrid(const HybridOptions& o) {
   const gl::ContextInfo& ctx = gl::context();
   const int dev = interop::cuda_device_of_gl();
   const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();
-  std::ofstream csv = open_csv(o.csv,
+  CsvFile csv = open_csv(o.csv,
                                "n,pipeline,mode,wall_ms,host_ms,gpu_ms,force_ms,update_ms,hand_off_us,"
                                "hand_off_host_us_per_step,floor_us,sm_mhz_median,slowed_fraction",
                                kRunColumns);

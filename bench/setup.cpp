@@ -143,36 +143,29 @@ std::string run_columns(const BenchOptions& o) {
 
 namespace {
 
-// The CSV files opened so far: each written into its temporary until finish_csv_files.
-std::vector<std::pair<std::filesystem::path, std::filesystem::path>>& pending_csv_files() {
-  static std::vector<std::pair<std::filesystem::path, std::filesystem::path>> files;  // temporary, file
+// The rows of each CSV file a bench has written, kept until finish_csv_files.
+std::vector<std::pair<std::string, std::string>>& finished_csv_files() {
+  static std::vector<std::pair<std::string, std::string>> files;  // file, rows
   return files;
 }
 
 }  // namespace
 
-std::ofstream open_csv(const std::string& path, const char* header, const char* tail) {
-  namespace fs = std::filesystem;
-  std::ofstream csv;
-  if (path.empty()) return csv;
-  std::error_code ec;
-  const bool regular = !fs::exists(path, ec) || fs::is_regular_file(path, ec);  // else a pipe or device, written to
-  const fs::path to = regular ? temporary(path) : fs::path(path);
-  errno = 0;
-  csv.open(to);
-  if (!csv) throw std::invalid_argument(write_error(path).what());  // with the system's reason
-  if (regular) pending_csv_files().emplace_back(to, path);
+CsvFile::~CsvFile() {
+  if (!file_.empty()) finished_csv_files().emplace_back(file_, str());
+}
+
+CsvFile open_csv(const std::string& path, const char* header, const char* tail) {
+  if (path.empty()) return {};
+  require_file_target(path, "--csv");  // before anything is measured
+  CsvFile csv(path);
   csv << header << tail << "\n";
   return csv;
 }
 
 void finish_csv_files(bool keep) {
-  for (const auto& [tmp, file] : std::exchange(pending_csv_files(), {})) {
-    std::error_code ec;
-    if (keep) std::filesystem::rename(tmp, file, ec);
-    if (!keep || ec) std::filesystem::remove(tmp);
-    if (keep && ec) throw std::runtime_error("cannot write " + file.string() + ": " + ec.message());
-  }
+  for (const auto& [file, rows] : std::exchange(finished_csv_files(), {}))
+    if (keep) write_atomically(file, rows);
 }
 
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,

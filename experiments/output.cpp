@@ -68,6 +68,15 @@ constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".de
 
 fs::path temporary(const fs::path& name) { return name.string().append(kTemporaryTag) + std::to_string(::getpid()); }
 
+void require_file_target(const std::string& file, const std::string& what) {
+  std::error_code ec;
+  if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
+  const fs::path folder = fs::path(file).parent_path();
+  if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
+  if (!folder.empty() && !fs::is_directory(folder, ec))
+    throw std::invalid_argument(what + " '" + file + "': no folder '" + folder.string() + "'");
+}
+
 void write_atomically(const fs::path& file, const std::string& text) {
   auto write = [&](const fs::path& to) { write_file(to.string(), [&](std::ostream& out) { out << text; }, true); };
   std::error_code ec;

@@ -36,6 +36,9 @@ void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 // removed or replaced.
 std::string foreign_frames_entry(const std::filesystem::path& frames);
 
+// Throws std::invalid_argument where `file`, named by `what` (a flag), could not be written: an
+// empty name, a folder in its place, or no folder to hold it.
+void require_file_target(const std::string& file, const std::string& what);
 // The temporary name of `name` for this process: "<name>.deformlab-tmp-<pid>". The names of
 // temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other
 // files are never taken for them.
