@@ -48,6 +48,7 @@ int experiment_command(const ExperimentArgs& a) {
     require_same_experiment(dir, x.name);
     if (!a.report_only) require_sweep_folder(dir, x, *sweep);
     else require_report_targets(dir);
+    if (!a.report_only) require_frames_fit(x, *sweep, dir, a.max_size);
     if (a.calibration) calibration = read_calibration(*a.calibration);
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";

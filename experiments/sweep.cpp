@@ -336,16 +336,29 @@ void require_same_experiment(const fs::path& dir, const std::string& name) {
                                 "', not '" + name + "': give this one another --out");
 }
 
+namespace {
+
+// Whether the experiment's own scene is a grid over --max-size, whose frames are then not drawn.
+bool over_max_size(const Experiment& x, std::optional<int> max_size) {
+  const ModelSpec& m = x.scene.model;
+  return max_size && m.topology != Topology::general && std::max({m.nx, m.ny, m.nz}) > *max_size;
+}
+
+}  // namespace
+
+void require_frames_fit(const Experiment& x, const Sweep& s, const fs::path& dir, std::optional<int> max_size) {
+  if (s.frames == 0 || x.scene.model.topology == Topology::general || over_max_size(x, max_size)) return;
+  const std::string why = frames_shortfall(x, model_size(x.scene.model));
+  if (why.empty() || frames_kept(dir, read_manifest(dir), x, s)) return;
+#if DEFORMLAB_HAVE_GL
+  if (!gl::unavailable_reason().empty()) return;  // no frames drawn here
+  throw std::invalid_argument("the experiment's own scene, whose frames its sweep draws (sweep.frames): " + why);
+#endif
+}
+
 int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
   using clock = std::chrono::steady_clock;
   require_same_experiment(dir, x.name);
-  // The frames' grid is counted before any cell runs (a mesh once it is read, after them).
-  const ModelSpec& own = x.scene.model;
-  const bool sized = own.topology != Topology::general;
-  const bool over_max_size = o.max_size && sized && std::max({own.nx, own.ny, own.nz}) > *o.max_size;
-  if (s.frames > 0 && sized && !over_max_size)
-    if (const auto why = frames_shortfall(x, model_size(own)); !why.empty())
-      throw std::invalid_argument("the experiment's own scene, whose frames its sweep draws (sweep.frames): " + why);
   fs::create_directories(dir / "cells");
   reclaim_temporaries(dir);
   reclaim_temporaries(dir / "cells");
@@ -396,8 +409,8 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
   }
   cache = {};
   if (s.frames > 0 && !fs::exists(dir / "frames")) {
-    if (over_max_size)
-      manifest["frames"] = {{"unavailable", "the experiment's " + describe(own) + " is over --max-size " +
+    if (over_max_size(x, o.max_size))
+      manifest["frames"] = {{"unavailable", "the experiment's " + describe(x.scene.model) + " is over --max-size " +
                                                 std::to_string(*o.max_size) + "; a run without it renders them"}};
     else
       manifest["frames"] = render_frames(x, s, dir);

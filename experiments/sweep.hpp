@@ -69,6 +69,12 @@ struct SweepOptions {
   std::optional<int> max_size;
 };
 
+// Throws std::invalid_argument where the experiment's own grid, whose frames sweep `s` would draw
+// into `dir` after its cells (with OpenGL, under --max-size, none kept there), does not fit this
+// host's memory; a mesh is counted once read, its frames then unavailable.
+void require_frames_fit(const Experiment& x, const Sweep& s, const std::filesystem::path& dir,
+                        std::optional<int> max_size);
+
 // Runs every cell not yet measured in `dir`/cells/ (n/a cells are tried again, and so are
 // cells measured with another scene or sweep method: sweep_folder.hpp) and returns the number
 // it ran. Writes `dir`/manifest.json (experiment, build, machine, calibration) first;

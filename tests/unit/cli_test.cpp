@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "core/memory.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -356,8 +357,8 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   std::ofstream(dir_ / "r" / "manifest.json") << manifest.dump();
   const Result frames = run(experiment + " --report-only");
   EXPECT_EQ(frames.code, 2);
-  EXPECT_EQ(frames.err, "deformlab: error: the manifest's frames.size: expected [width, height], as the experiment "
-                        "writes it\n");
+  EXPECT_EQ(frames.err, "deformlab: error: " + (dir_ / "r" / "manifest.json").string() +
+                            ": frames.size: expected [width, height], as the experiment writes it\n");
 }
 
 // A folder where an experiment writes a file (a cell's, the report) is refused before any cell
@@ -455,17 +456,15 @@ TEST_F(Cli, GlDeviceNeedsAGlPassOrFrames) {
   EXPECT_EQ(bare.err, "deformlab: error: --gl-device: pipeline 'cpu' runs no OpenGL pass, and no --frames are drawn\n");
   EXPECT_FALSE(fs::exists(dir_ / "bare"));
   const Result framed = run(args + (dir_ / "framed").string() + " --frames 2");
+  if (framed.err.find("OpenGL unavailable") != std::string::npos) GTEST_SKIP() << framed.err;
   EXPECT_EQ(framed.code, 0) << framed.err;
   EXPECT_TRUE(fs::exists(dir_ / "framed" / "frames")) << framed.err;
 }
 
-// The host's MemAvailable, GiB.
+// The host memory the programs count against (MemAvailable, or a tighter cgroup limit), GiB.
 double available_gib() {
-  std::ifstream meminfo("/proc/meminfo");
-  std::string key;
-  long long kb = 0;
-  while (meminfo >> key >> kb && key != "MemAvailable:") meminfo.ignore(64, '\n');
-  return double(kb) / (1 << 20);
+  const auto limit = host_memory_limit();
+  return limit ? double(limit->bytes) / double(1LL << 30) : 1e9;
 }
 
 // deformlab-bench checks a size against the host's memory before it builds the model. Its
@@ -511,6 +510,8 @@ TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
   write("x.json", R"({"name": "big-frames", "scene": {"model": {"size": [32768, 32768]}},
                       "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2, "frames": 1}})");
   const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
+  if (r.code == 0 && slurp(dir_ / "r" / "manifest.json").find("OpenGL") != std::string::npos)
+    GTEST_SKIP() << "no OpenGL here: no frames are drawn";
   EXPECT_EQ(r.code, 2);
   const std::string line = r.err.substr(r.err.rfind("deformlab: error: "));
   EXPECT_EQ(line.rfind("deformlab: error: the experiment's own scene, whose frames its sweep draws (sweep.frames): a "
