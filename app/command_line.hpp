@@ -83,9 +83,6 @@ inline void cap_openmp_threads(const std::string& program) {
   omp_set_num_threads(hardware);
 }
 
-// Parses `argv` into `cli`: help is printed (0); an unknown command, or a parse error, is one
-// line on stderr, the latter naming the help of the command it was in, "program command --help"
-// (2). Else -1.
 // `code`, once what the program printed has reached its standard output; where it could not
 // (a full disk, a closed pipe), one line saying so and `code`, or 1 for a success.
 inline int flush_output(const std::string& program, int code) {
@@ -93,6 +90,10 @@ inline int flush_output(const std::string& program, int code) {
   std::cerr << program << ": error: standard output could not be written (a full disk, a closed pipe?)\n";
   return code ? code : 1;
 }
+
+// Parses `argv` into `cli`: help is printed (0); an unknown command, or a parse error, is one
+// line on stderr, the latter naming the help of the command it was in, "program command --help"
+// (2). Else -1.
 
 inline int parse_command_line(CLI::App& cli, int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-') {

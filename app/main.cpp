@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     return deformlab::app::flush_output("deformlab", 0);
   }
   if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0)
-    return deformlab::app::flush_output("deformlab", code);  // --help
+    return deformlab::app::flush_output("deformlab", code);  // help, or a parse error
   deformlab::app::cap_openmp_threads("deformlab");
   int code = 2;
   if (*run) code = deformlab::app::run_command(a);

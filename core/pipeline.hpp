@@ -162,6 +162,8 @@ inline constexpr double kGpuTimedMs = 200.0;
 int steps_spanning(double ms, double step_ms, int min_steps, int multiple = 1);
 // Whether any of e's passes runs on a GPU (it then warms up before it is timed).
 bool on_gpu(const PipelineEntry& e);
+// Whether `e` is one of the OpenGL engines.
+inline bool is_gl(Engine e) { return e == Engine::gl_compute || e == Engine::gl_transform_feedback; }
 
 class PipelineRegistry {
  public:

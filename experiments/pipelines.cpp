@@ -131,7 +131,6 @@ std::string option_values(const PipelineEntry& e, const std::string& name) {
 
 bool on_software_gl(const PipelineEntry& e) {
 #if DEFORMLAB_HAVE_GL
-  auto is_gl = [](Engine x) { return x == Engine::gl_compute || x == Engine::gl_transform_feedback; };
   const bool gl = is_gl(e.traits.force) || is_gl(e.traits.update);
   return gl && e.unavailable().empty() && gl::context().software;
 #else

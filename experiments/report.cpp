@@ -291,7 +291,8 @@ void write_frames(Report& r) {
   }
   const json size = frames.value("size", json());
   if (!size.is_array() || size.size() != 2 || !size[0].is_number_unsigned() || !size[1].is_number_unsigned())
-    throw std::invalid_argument("the manifest's frames.size: expected [width, height], as the experiment writes it");
+    throw std::invalid_argument((r.dir / "manifest.json").string() +
+                                ": frames.size: expected [width, height], as the experiment writes it");
   r.md << "The experiment's own scene (" << frames.value("nodes", 0) << " nodes) on `"
        << frames.value("pipeline", std::string()) << "`, " << frames.value("integrator", std::string()) << ", a "
        << size[0] << " x " << size[1] << " frame every " << frames.value("every_steps", 0) << " steps of "

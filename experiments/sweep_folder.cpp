@@ -64,35 +64,39 @@ void record_earlier_measurements(const fs::path& dir, const json& old, const Exp
   }
 }
 
+namespace {
+
+[[noreturn]] void refuse(const fs::path& dir, const std::string& entry, const std::string& why) {
+  throw std::invalid_argument("results folder '" + dir.string() + "' holds '" + entry + "', " + why +
+                              ": move it or give another --out");
+}
+
+}  // namespace
+
 void require_report_targets(const fs::path& dir) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     if ((is_report_file(name) || name == "manifest.json") && !e.is_regular_file(ec))
-      throw std::invalid_argument("results folder '" + dir.string() + "' holds '" + name +
-                                  "', where the experiment writes a file: move it or give another --out");
+      refuse(dir, name, "where the experiment writes a file");
   }
 }
 
 void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep& s) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return;
-  auto refuse = [&](const std::string& entry, const std::string& why) {
-    throw std::invalid_argument("results folder '" + dir.string() + "' holds '" + entry + "', " + why +
-                                ": move it or give another --out");
-  };
   const json old = read_manifest(dir);
   const bool results = old.is_object() && old.contains("experiment") && old["experiment"].is_object();
   if (!results)
     for (const auto& e : fs::directory_iterator(dir, ec)) {
       const std::string name = e.path().filename().string();
       if (is_report_file(name) || name == "frames" || name == "manifest.json")
-        refuse(name, "which no experiment wrote there");
+        refuse(dir, name, "which no experiment wrote there");
     }
   require_report_targets(dir);
   for (const char* folder : {"cells", "frames"})
     if (fs::exists(fs::symlink_status(dir / folder, ec)) && !fs::is_directory(fs::symlink_status(dir / folder, ec)))
-      refuse(folder, "where the experiment writes a folder");
+      refuse(dir, folder, "where the experiment writes a folder");
   std::set<std::string> ids;
   if (results)
     for (const auto& c : cells(s)) ids.insert(c.id() + ".json");  // a damaged one is measured again
@@ -100,11 +104,11 @@ void require_sweep_folder(const fs::path& dir, const Experiment& x, const Sweep&
     const std::string name = f.path().filename().string();
     if (is_temporary(name)) continue;  // a killed run's, reclaimed by the next
     if (f.path().extension() != ".json" || (!ids.count(name) && read_cell(f.path()).is_null()))
-      refuse("cells/" + name, "which is not a cell result");
-    if (!f.is_regular_file(ec)) refuse("cells/" + name, "where the experiment writes a cell's file");
+      refuse(dir, "cells/" + name, "which is not a cell result");
+    if (!f.is_regular_file(ec)) refuse(dir, "cells/" + name, "where the experiment writes a cell's file");
   }
   if (frames_kept(dir, old, x, s)) return;
-  if (const std::string e = foreign_frames_entry(dir / "frames"); !e.empty()) refuse("frames/" + e, "which no run writes there");
+  if (const std::string e = foreign_frames_entry(dir / "frames"); !e.empty()) refuse(dir, "frames/" + e, "which no run writes there");
 }
 
 }  // namespace deformlab

@@ -135,8 +135,7 @@ constexpr int kSteps = 50;
 // which keeps subnormals where a GPU may flush them: there it does `cpu`'s operations bit for bit.
 bool gl_exact_on_software(const PipelineEntry& e, const PipelineOptions& o) {
 #if DEFORMLAB_HAVE_GL
-  const auto gl = [](Engine x) { return x == Engine::gl_compute || x == Engine::gl_transform_feedback; };
-  return gl(e.traits.force) && gl(e.traits.update) && math_option(o) == Math::exact && gl::context().software;
+  return is_gl(e.traits.force) && is_gl(e.traits.update) && math_option(o) == Math::exact && gl::context().software;
 #else
   (void)e, (void)o;
   return false;
