@@ -94,7 +94,6 @@ inline int flush_output(const std::string& program, int code) {
 // Parses `argv` into `cli`: help is printed (0); an unknown command, or a parse error, is one
 // line on stderr, the latter naming the help of the command it was in, "program command --help"
 // (2). Else -1.
-
 inline int parse_command_line(CLI::App& cli, int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

@@ -36,7 +36,6 @@ void check_run_flags(const RunArgs& a);
 // the kernel's own file systems (proc, sysfs, ...), which hold no files of ours, or where this
 // process may not write (the nearest folder above it that exists, where it does not).
 void require_writable(const std::filesystem::path& out);
-
 // `run`'s output folder is checked first, before the model is built; `view` writes none.
 enum class Output { folder, none };
 RunInput read_run_input(const RunArgs& a, Output output = Output::folder);

@@ -89,8 +89,8 @@ inline constexpr const char* kBuildColumn = ",build";
 std::string run_columns(const BenchOptions& o);
 std::string build_column();
 // The rows of a CSV file (none: no file), kept in memory: the file is written whole by
-// finish_csv_files(true) once the bench has ended well, so that bad input found partway, a
-// failure or a kill leave the file as it was.
+// finish_csv_files once the bench has ended well, so that bad input found partway, a failure or
+// a kill leave the file as it was.
 class CsvFile : public std::ostringstream {
  public:
   CsvFile() = default;
@@ -104,8 +104,8 @@ class CsvFile : public std::ostringstream {
 };
 // The file, which must be writable where it is named (else std::invalid_argument), with its header.
 CsvFile open_csv(const std::string& path, const char* header, const char* tail);
-// Writes each file whose CsvFile is gone (keep), or drops them; throws where one cannot be written.
-void finish_csv_files(bool keep);
+// Writes each file whose CsvFile is gone; throws where one cannot be written.
+void finish_csv_files();
 
 // What the per-step benches (cpu, gl) take: BenchOptions and the number of timed steps.
 struct StepOptions : BenchOptions {

@@ -27,17 +27,14 @@ int main(int argc, char** argv) {
     // The benches run in the parser's callbacks and print their results as they go.
     if (const int code = deformlab::app::parse_command_line(cli, argc, argv); code >= 0)
       return deformlab::app::flush_output("deformlab-bench", code);
-    deformlab::bench::finish_csv_files(true);
+    deformlab::bench::finish_csv_files();
   } catch (const std::invalid_argument& e) {  // bad input
-    deformlab::bench::finish_csv_files(false);
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 2;
   } catch (const std::bad_alloc&) {  // a pipeline's allocation: the check before the model counts only it
-    deformlab::bench::finish_csv_files(false);
     std::cerr << "deformlab-bench: error: out of memory (host or device): the model or its pipeline does not fit this machine\n";
     return 2;
   } catch (const std::exception& e) {
-    deformlab::bench::finish_csv_files(false);
     std::cerr << "deformlab-bench: error: " << deformlab::one_line(e.what()) << "\n";
     return 1;
   }

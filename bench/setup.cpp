@@ -1,8 +1,6 @@
 // The benches' shared scene, flags, statistics and CSV files (bench.hpp).
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <filesystem>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -14,7 +12,6 @@
 #include "app/command_line.hpp"
 #include "bench.hpp"
 #include "core/profiler.hpp"
-#include "core/write_error.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
@@ -163,9 +160,8 @@ CsvFile open_csv(const std::string& path, const char* header, const char* tail) 
   return csv;
 }
 
-void finish_csv_files(bool keep) {
-  for (const auto& [file, rows] : std::exchange(finished_csv_files(), {}))
-    if (keep) write_atomically(file, rows);
+void finish_csv_files() {
+  for (const auto& [file, rows] : std::exchange(finished_csv_files(), {})) write_atomically(file, rows);
 }
 
 void add_step_bench(CLI::App& app, const char* name, const char* description, std::vector<int> sizes, int warmup,

@@ -44,7 +44,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       temporal_ = true;
       plan_ = plan_temporal(m, o_);
     }
-    sets_ = !temporal_ && sched_.rule == UpdateRule::verlet ? 3 : 2;
+    sets_ = state_sets(su.integrator, o_.variant);
     if (dev::kPrefetchAhead && fused_ && m.grid()) plan_prefetch();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");

@@ -99,6 +99,10 @@ std::string unsupported(Integrator i, Variant v);
 // Device bytes of a general model's springs as variant v reads them (the CSR adjacency, or
 // the scatter's spring list); 0 for grids, whose springs are the stencil.
 std::int64_t spring_bytes(const ModelSize& m, Variant v);
+// The (x, v) state sets a pipeline cycles through: three for the one-step Verlet kernels, whose
+// step reads the previous positions from the set before, else two (cuda-temporal keeps Verlet's
+// previous positions apart).
+int state_sets(Integrator i, Variant v);
 // Device memory a pipeline needs, bytes (state, stage slots, model arrays).
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o);
 // Device memory the pipelines' buffers hold now, bytes: what bytes_needed is tested against.

@@ -129,6 +129,10 @@ std::int64_t spring_bytes(const ModelSize& m, Variant v) {
   return (m.nodes + 1) * 4 + 2 * m.springs * 16;
 }
 
+int state_sets(Integrator i, Variant v) {
+  return make_schedule(i).rule == UpdateRule::verlet && v != Variant::temporal ? 3 : 2;
+}
+
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   const Schedule s = make_schedule(i);
   const std::int64_t n = m.nodes, f4 = 16;
@@ -136,10 +140,8 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   b += n * 2 * f4 * s.stage_states;
   const bool one_kernel = (o.variant == Variant::fused || o.variant == Variant::temporal) && s.single_pass();
   if (!one_kernel) b += n * f4 * s.accel_slots;
-  const bool verlet = s.rule == UpdateRule::verlet;
-  if (verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
-  const int sets = verlet && o.variant != Variant::temporal ? 3 : 2;
-  b += (sets + 1) * 4;  // the stop rule's largest displacement from each state set, and its result
+  if (s.rule == UpdateRule::verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
+  b += (state_sets(i, o.variant) + 1) * 4;  // the stop rule's largest displacement from each set, and its result
   return b + spring_bytes(m, o.variant);
 }
 

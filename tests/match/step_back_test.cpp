@@ -195,7 +195,7 @@ TEST(StepBackPipelines, PingPongPipelinesCanStepBack) {
 std::vector<std::string> gpu_pipeline_names() {
   std::vector<std::string> out;
   for (const auto& e : pipelines().all())
-    if (e.traits.force != Engine::cpu) out.push_back(e.name);
+    if (on_gpu(e)) out.push_back(e.name);
   return out;
 }
 
