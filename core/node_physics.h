@@ -69,6 +69,17 @@ DL_FN int grid_node(int i, int j, int k, int nx, int ny) { return (k * ny + j) *
 // j = grid_axis(n, nx, ny), k = grid_axis(n, nx * ny, nz).
 DL_FN int grid_axis(int n, int stride, int size) { return (n / stride) % size; }
 
+// How far a grid node's springs reach along an axis (flexion springs: two nodes; the stencil in
+// core/grid_stencil.hpp, checked against it there).
+#define STENCIL_REACH 2
+
+// Whether every stencil neighbour of node (i, j, k) lies in the grid (layers: the stencil also
+// reaches along k, as a lattice's does), so that a gather need not check each one.
+DL_FN bool grid_interior(CREF(StepParams) p, int i, int j, int k, bool layers) {
+  return i >= STENCIL_REACH && i < p.nx - STENCIL_REACH && j >= STENCIL_REACH && j < p.ny - STENCIL_REACH &&
+         (!layers || (k >= STENCIL_REACH && k < p.nz - STENCIL_REACH));
+}
+
 // Node (i, j, k) + (di, dj, dk), or -1 when that lies outside the grid.
 DL_FN int grid_neighbour(CREF(StepParams) p, int i, int j, int k, int di, int dj, int dk) {
   int a = i + di, b = j + dj, c = k + dk;

@@ -14,6 +14,15 @@ namespace deformlab {
 // A grid's index maths (core/node_physics.h), the same for every precision.
 using Grid = Physics<float>;
 
+// Model m's grid dimensions, as the index maths reads them (Grid::grid_neighbour).
+inline Grid::StepParams grid_extent(const Model& m) {
+  Grid::StepParams p{};
+  p.nx = m.nx;
+  p.ny = m.ny;
+  p.nz = m.nz;
+  return p;
+}
+
 struct SpringRef {
   int i, j;  // end nodes, i < j
   float rest, k, kd;
@@ -30,14 +39,15 @@ void for_each_spring(const Model& m, F&& f) {
     return;
   }
   const int size = grid_stencil_size(m.volume());
+  const Grid::StepParams extent = grid_extent(m);
   for (int k = 0; k < m.nz; ++k)
     for (int j = 0; j < m.ny; ++j)
       for (int i = 0; i < m.nx; ++i)
         for (int e = size / 2; e < size; ++e) {
           const GridOffset o = grid_offset(m.volume(), e);
-          const int a = i + o.di, b = j + o.dj, c = k + o.dk;
-          if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
-          const int u = Grid::grid_node(i, j, k, m.nx, m.ny), v = Grid::grid_node(a, b, c, m.nx, m.ny);
+          const int v = Grid::grid_neighbour(extent, i, j, k, o.di, o.dj, o.dk);
+          if (v < 0) continue;
+          const int u = Grid::grid_node(i, j, k, m.nx, m.ny);
           f(SpringRef{std::min(u, v), std::max(u, v), grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind],
                       SpringKind(o.kind)});
         }
@@ -55,11 +65,11 @@ void for_each_link(const Model& m, int v, F&& f) {
     return;
   }
   const int i = Grid::grid_axis(v, 1, m.nx), j = Grid::grid_axis(v, m.nx, m.ny), k = Grid::grid_axis(v, m.nx * m.ny, m.nz);
+  const Grid::StepParams extent = grid_extent(m);
   for (int e = 0; e < grid_stencil_size(m.volume()); ++e) {
     const GridOffset o = grid_offset(m.volume(), e);
-    const int a = i + o.di, b = j + o.dj, c = k + o.dk;
-    if (a < 0 || a >= m.nx || b < 0 || b >= m.ny || c < 0 || c >= m.nz) continue;
-    f(Grid::grid_node(a, b, c, m.nx, m.ny), grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind]);
+    const int w = Grid::grid_neighbour(extent, i, j, k, o.di, o.dj, o.dk);
+    if (w >= 0) f(w, grid_rest_length(m, o), m.stiffness[o.kind], m.damping[o.kind]);
   }
 }
 

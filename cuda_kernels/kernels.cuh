@@ -100,12 +100,11 @@ __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stenc
   return f;
 }
 
-// The gather with bounds checks only for nodes within 2 of a border.
+// The gather with bounds checks only for nodes near a border (P::grid_interior).
 template <int N, bool Damped>
 __device__ __forceinline__ Vec3f gather_grid(const StepParams& s, const Stencil& st, int i, int j, int k,
                                              const Vec3f& xi, const Vec3f& vi, const Window& w) {
-  const bool inside = i >= 2 && i < s.nx - 2 && j >= 2 && j < s.ny - 2 && (N == 12 || (k >= 2 && k < s.nz - 2));
-  if (inside) return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
+  if (P::grid_interior(s, i, j, k, N > 12)) return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
   return gather_stencil<N, Damped, true>(s, st, i, j, k, xi, vi, w);
 }
 
@@ -200,7 +199,7 @@ constexpr bool kPrefetchAhead = false;
 #endif
 
 // Halo of the shared tile: flexion springs reach two nodes.
-constexpr int kHalo = 2;
+constexpr int kHalo = STENCIL_REACH;
 
 // Loads the block's nodes and their halo (2 in i and j, and in k on lattices) into shared
 // memory, coalesced along i. Cells outside the grid are left unset and never read.

@@ -103,7 +103,7 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
                   StopCheck check) {
   constexpr bool kVolume = N > 12, kVerlet = Rule == RULE_VERLET;
   extern __shared__ float4 sh[];
-  const Region<kVolume> r(tile, 2 * steps);
+  const Region<kVolume> r(tile, kHalo * steps);
   const int cells = r.count();
   // Copy c of the positions and of the velocities (offsets, not an array of pointers: one
   // indexed by the step's parity would live in local memory).
@@ -119,7 +119,7 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
   int cur = 0;
   for (int q = 0; q < steps; ++q) {
     const bool prev = has_prev || q > 0;
-    for_each_cell<kVolume>(r.valid(s, 2 * (q + 1)), [&](int3 c) {
+    for_each_cell<kVolume>(r.valid(s, kHalo * (q + 1)), [&](int3 c) {
       const int i = r.first.x + c.x, j = r.first.y + c.y, k = r.first.z + c.z, l = r.index(c);
       const int node = P::grid_node(i, j, k, s.nx, s.ny);
       const float4 x4 = sx(cur)[l], v4 = sv(cur)[l];

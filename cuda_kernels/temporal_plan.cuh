@@ -31,7 +31,7 @@ struct TemporalPlan {
 inline TemporalPlan plan_temporal(const Model& m, const Options& o) {
   TemporalPlan plan;
   plan.k = cuda::steps_per_launch(o);
-  const int halo = 2 * plan.k;
+  const int halo = dev::kHalo * plan.k;
   const bool volume = m.volume();
   const std::size_t cell = 4 * sizeof(float4);
   int device = 0, limit = 0, per_sm = 0, reserved = 0;

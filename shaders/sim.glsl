@@ -93,12 +93,11 @@ const ivec3 kStencilOffset[STENCIL_SIZE] = STENCIL_OFFSETS;
 vec3 springs_on(int i, vec3 xi, vec3 vi) {
   DL_PRECISE vec3 f = vec3(0.0);
 #ifdef TOPOLOGY_GRID
-  // STENCIL_SIZE entries (a compile-time count, so that the loops can unroll); only nodes within
-  // 2 of a border check whether each neighbour is in the grid.
+  // STENCIL_SIZE entries (a compile-time count, so that the loops can unroll); only nodes near a
+  // border check whether each neighbour is in the grid.
   ivec3 c = node_cell(i);
   int layer = params.nx * params.ny;
-  if (c.x >= 2 && c.x < params.nx - 2 && c.y >= 2 && c.y < params.ny - 2 &&
-      (STENCIL_SIZE == 12 || (c.z >= 2 && c.z < params.nz - 2))) {
+  if (grid_interior(params, c.x, c.y, c.z, STENCIL_SIZE != 12)) {
     for (int e = 0; e < STENCIL_SIZE; ++e) {
       ivec3 o = STENCIL_OFFSET(e);
       int j = i + o.x + o.y * params.nx + o.z * layer;

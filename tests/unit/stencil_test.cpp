@@ -50,6 +50,36 @@ TEST(GridStencil, EveryNeighbourOnceIncomingThenOwn) {
   }
 }
 
+// The gathers skip the per-neighbour check where grid_interior holds, and the CUDA tiles take a
+// halo of STENCIL_REACH: both must agree with the stencil's table.
+TEST(GridStencil, InteriorNodesAreThoseWithEveryNeighbourInTheGrid) {
+  for (bool volume : {false, true}) {
+    int reach = 0;
+    for (int e = 0; e < grid_stencil_size(volume); ++e) {
+      const GridOffset o = grid_offset(volume, e);
+      reach = std::max({reach, std::abs(o.di), std::abs(o.dj), std::abs(o.dk)});
+    }
+    EXPECT_EQ(reach, STENCIL_REACH);
+    Grid::StepParams p{};
+    p.nx = 7;
+    p.ny = 6;
+    p.nz = volume ? 5 : 1;
+    int interior = 0;
+    for (int k = 0; k < p.nz; ++k)
+      for (int j = 0; j < p.ny; ++j)
+        for (int i = 0; i < p.nx; ++i) {
+          bool all_in = true;
+          for (int e = 0; e < grid_stencil_size(volume); ++e) {
+            const GridOffset o = grid_offset(volume, e);
+            all_in = all_in && Grid::grid_neighbour(p, i, j, k, o.di, o.dj, o.dk) >= 0;
+          }
+          EXPECT_EQ(Grid::grid_interior(p, i, j, k, volume), all_in) << i << ", " << j << ", " << k;
+          interior += all_in;
+        }
+    EXPECT_EQ(interior, volume ? 3 * 2 * 1 : 3 * 2);
+  }
+}
+
 // Each node's stencil neighbours inside the grid (and for_each_link's) are the adjacency of
 // the grid's explicit springs (each node's own stencil half), spring for spring (kind and
 // rest length), and in the same order once the grid is at least 5 nodes wide.
