@@ -9,8 +9,8 @@
 namespace deformlab::app {
 
 int list_command() {
-  std::cout << "Pipelines (in order of expected speed; 'best' picks the first available, passing over GL on a "
-               "software rasteriser):\n";
+  std::cout << "Pipelines (in order of their step time on a 2048^2 cloth on an H100; 'best' picks the first "
+               "available, passing over GL on a software rasteriser):\n";
   for (const auto& e : pipelines().all()) {
     const std::string why = e.unavailable();
     std::cout << "  " << std::left << std::setw(15) << e.name << (why.empty() ? "available    " : "unavailable  ")

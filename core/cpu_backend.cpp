@@ -26,10 +26,6 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
   };
 
  public:
-  // OpenMP threads: at least kNodesPerThread nodes each, so that small models do not pay
-  // for more barriers than they have work (a thread more changes no result).
-  static constexpr int kNodesPerThread = 1024;
-
   CpuPipeline(const PipelineSetup& s, bool parallel)
       : m_(s.model),
         p_(s.params),
@@ -314,16 +310,12 @@ void add_cpu_pipelines(PipelineRegistry& r) {
   auto in = [](Precision p) {
     return [p](const ModelSize& m, Integrator i, const PipelineOptions&) { return cpu_footprint(m, i, p); };
   };
-  const PipelineTraits as_cpu{}, in_double{.cpu_match = CpuMatch::rounding};
-  r.add({"cpu", "single-threaded float (the paper's unoptimised CPU)", as_cpu, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); }, {}, in(Precision::f32)});
-  r.add({"omp", "OpenMP float, up to " + std::to_string(omp_get_max_threads()) + " threads of at least " +
-                    std::to_string(CpuPipeline<float>::kNodesPerThread) +
-                    " nodes each (the paper's optimised CPU); bitwise equal to cpu",
-         as_cpu, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); }, {}, in(Precision::f32)});
-  r.add({"reference", "OpenMP double: the reference for tests and --compare", in_double, always, every,
-         [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }, {}, in(Precision::f64)});
+  r.add(described("cpu", always, every, [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, false); },
+                  in(Precision::f32)));
+  r.add(described("omp", always, every, [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f32, true); },
+                  in(Precision::f32)));
+  r.add(described("reference", always, every,
+                  [](const PipelineSetup& s) { return make_cpu_pipeline(s, Precision::f64, true); }, in(Precision::f64)));
 }
 
 }  // namespace deformlab

@@ -12,6 +12,10 @@ namespace deformlab {
 
 enum class Precision { f32, f64 };
 
+// The OpenMP pipelines' threads: at least this many nodes each, so that small models do not
+// pay for more barriers than they have work (a thread more changes no result).
+inline constexpr int kNodesPerThread = 1024;
+
 std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p, bool parallel);
 
 // Adds `cpu`, `omp` and `reference` (double, OpenMP) to the registry.

@@ -62,7 +62,7 @@ class Pipeline {
 };
 
 // Per-pipeline settings by name, e.g. {"tile": "16x8"} or {"interop": "map"}; each
-// pipeline lists the names it reads in its registry entry (PipelineEntry::options).
+// pipeline lists the names it reads in its kind (PipelineKind::options).
 using PipelineOptions = std::map<std::string, std::string>;
 
 // How a GPU pipeline's kernels and shaders do their float arithmetic (the pipeline option
@@ -91,7 +91,7 @@ enum class Engine { cpu, cuda, gl_compute, gl_transform_feedback };
 enum class CpuMatch { bitwise, rounding };
 
 // What a pipeline is, as plain data for tests, sweeps and reports. A name carries the same
-// traits whether or not this build has its backend (experiments/pipelines.cpp).
+// traits whether or not this build has its backend (PipelineKind).
 struct PipelineTraits {
   Engine force = Engine::cpu, update = Engine::cpu;
   bool deterministic = true;  // bitwise equal run to run
@@ -101,6 +101,19 @@ struct PipelineTraits {
   bool hands_off() const { return force != update; }
   bool operator==(const PipelineTraits&) const = default;
 };
+
+// A pipeline as every build knows it, whichever backends the build has: written once, in
+// core/pipeline_kinds.cpp, in order of expected speed on a GPU machine.
+struct PipelineKind {
+  std::string name;
+  std::string summary;
+  std::string needs;  // what a build needs to have it ("CUDA", "OpenGL", ...; empty: every build)
+  PipelineTraits traits;
+  std::vector<std::string> options;  // option names it reads (see PipelineOptions)
+};
+const std::vector<PipelineKind>& pipeline_kinds();
+// The kind named `name`; throws std::logic_error where there is none.
+const PipelineKind& pipeline_kind(const std::string& name);
 
 struct PipelineEntry {
   std::string name;
@@ -119,6 +132,14 @@ struct PipelineEntry {
   // (what depends on the device, such as a GL limit, is checked when the pipeline is made).
   std::function<void(const PipelineOptions&)> read_options = {};
 };
+
+// The entry a backend registers for kind `name`: the kind's name, summary, traits and options,
+// with the backend's functions.
+PipelineEntry described(const std::string& name, std::function<std::string()> unavailable,
+                        std::function<std::string(Integrator)> unsupported,
+                        std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make,
+                        std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint,
+                        std::function<void(const PipelineOptions&)> read_options = {});
 
 // How `e` run with options `o` compares with the `cpu` pipeline: its trait, or rounding
 // where the options choose fast math.

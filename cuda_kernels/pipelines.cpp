@@ -175,43 +175,19 @@ double floor_bytes_per_node(const Model& m, Integrator i, const Options& o) {
 
 void add_cuda_pipelines(PipelineRegistry& r) {
   using cuda::Variant;
-  struct Entry {
-    const char* name;
-    Variant v;
-    const char* summary;
-  };
-  const Entry entries[] = {
-      {"cuda-naive", Variant::naive, "CUDA, one thread per node gathering its springs from global memory"},
-      {"cuda-tiled", Variant::tiled,
-       "CUDA, gather from shared-memory tiles (grids: the block with a 2-node halo; meshes: Z-order tiles with their halos)"},
-      {"cuda-scatter", Variant::scatter, "CUDA, one thread per spring, atomic scatter of +f/-f"},
-      {"cuda-fused", Variant::fused,
-       "CUDA, force + update + constraints in one kernel (one-pass integrators; others use the plain gather)"},
-      {"cuda-temporal", Variant::temporal,
-       "CUDA, k fused steps per launch on shared-memory tiles with a 2k-node halo (grids; one-pass integrators)"},
-  };
-  for (const Entry& e : entries) {
-    const Variant v = e.v;
-    // The gathers give the CPU's bits (tests/cuda); atomics add a node's forces in any order.
-    const bool gather = v != Variant::scatter;
-    const PipelineTraits traits{Engine::cuda, Engine::cuda, gather, gather ? CpuMatch::bitwise : CpuMatch::rounding,
-                                v == Variant::temporal};
-    // "tile": the thread block shape WxH of the grid kernels (default 16x8); on cuda-temporal
-    // the nodes a block writes, with "steps_per_launch"; "tma" (on|off) on cuda-fused.
-    std::vector<std::string> options;
-    if (gather) options.push_back("tile");
-    if (v == Variant::temporal) options.push_back("steps_per_launch");
-    if (v == Variant::fused) options.push_back("tma");
-    options.push_back("math");
-    r.add({e.name, e.summary, traits, [] { return cuda::unavailable(); },
-           [v](Integrator i) { return cuda::unsupported(i, v); },
-           [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> { return cuda::make_pipeline(s, options_of(v, s.options)); },
-           options,
-           [v](const ModelSize& m, Integrator i, const PipelineOptions& o) {
-             return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, cuda::options_of(v, o))};
-           },
-           [v](const PipelineOptions& o) { cuda::options_of(v, o); }});
-  }
+  const std::pair<const char*, Variant> variants[] = {{"cuda-naive", Variant::naive},
+                                                      {"cuda-tiled", Variant::tiled},
+                                                      {"cuda-scatter", Variant::scatter},
+                                                      {"cuda-fused", Variant::fused},
+                                                      {"cuda-temporal", Variant::temporal}};
+  for (const auto& [name, v] : variants)
+    r.add(described(
+        name, [] { return cuda::unavailable(); }, [v](Integrator i) { return cuda::unsupported(i, v); },
+        [v](const PipelineSetup& s) -> std::unique_ptr<Pipeline> { return cuda::make_pipeline(s, options_of(v, s.options)); },
+        [v](const ModelSize& m, Integrator i, const PipelineOptions& o) {
+          return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, cuda::options_of(v, o))};
+        },
+        [v](const PipelineOptions& o) { cuda::options_of(v, o); }));
 }
 
 }  // namespace deformlab

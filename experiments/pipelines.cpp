@@ -21,45 +21,6 @@
 namespace deformlab {
 namespace {
 
-// Each pipeline as every build knows it: its traits and options are checked against the
-// registered entry where the build has it, and carried by the placeholder where not.
-struct Known {
-  const char* name;
-  const char* summary;
-  const char* needs;  // why it may be missing from a build
-  PipelineTraits traits;
-  std::vector<std::string> options = {};
-};
-
-constexpr PipelineTraits on(Engine e, bool deterministic = true, CpuMatch m = CpuMatch::rounding) {
-  return {e, e, deterministic, m};
-}
-constexpr PipelineTraits hybrid(Engine update) { return {Engine::cuda, update, true, CpuMatch::rounding}; }
-
-// In order of expected speed on a GPU machine (cuda-temporal, faster on grids, follows
-// cuda-fused, which runs every model); the CPU pipelines close the list.
-const Known kKnown[] = {
-    {"cuda-fused", "CUDA, force and update in one kernel", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise),
-     {"tile", "tma", "math"}},
-    {"cuda-temporal", "CUDA, k fused steps per launch on shared-memory tiles (grids)", "CUDA",
-     {Engine::cuda, Engine::cuda, true, CpuMatch::bitwise, true}, {"tile", "steps_per_launch", "math"}},
-    {"cuda-tiled", "CUDA, shared-memory tiled gather", "CUDA", on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
-    {"cuda-naive", "CUDA, one thread per node gathering from global memory", "CUDA",
-     on(Engine::cuda, true, CpuMatch::bitwise), {"tile", "math"}},
-    {"cuda-scatter", "CUDA, one thread per spring, atomic scatter", "CUDA", on(Engine::cuda, false), {"math"}},
-    {"glsl-compute", "GLSL compute shaders over storage buffers", "OpenGL", on(Engine::gl_compute),
-     {"window", "link_view", "math", "memory"}},
-    {"glsl-tf", "GLSL vertex shader + transform feedback (the paper's)", "OpenGL", on(Engine::gl_transform_feedback),
-     {"link_view", "math", "memory"}},
-    {"hybrid", "CUDA forces into GL buffers, transform feedback update", "CUDA and OpenGL",
-     hybrid(Engine::gl_transform_feedback), {"interop", "force", "tile", "math"}},
-    {"hybrid-compute", "CUDA forces into GL buffers, compute-shader update", "CUDA and OpenGL",
-     hybrid(Engine::gl_compute), {"interop", "force", "tile", "math"}},
-    {"omp", "", "", {}},
-    {"cpu", "", "", {}},
-    {"reference", "", "", {.cpu_match = CpuMatch::rounding}},
-};
-
 PipelineRegistry build() {
   PipelineRegistry built;
   add_cpu_pipelines(built);
@@ -76,21 +37,18 @@ PipelineRegistry build() {
 #if DEFORMLAB_HAVE_INTEROP
   add_hybrid_pipelines(built);
 #endif
+  // Every kind, in its order: the build's entry, or a placeholder that says what it needs.
   PipelineRegistry r;
-  for (const auto& k : kKnown) {
+  for (const PipelineKind& k : pipeline_kinds()) {
     if (const PipelineEntry* e = built.find(k.name)) {
-      if (!(e->traits == k.traits) || e->options != k.options)
-        throw std::logic_error(std::string("pipeline ") + k.name + " registers other traits or options than kKnown's");
       r.add(*e);
       continue;
     }
-    const std::string why = std::string("not in this build (needs ") + k.needs + " support at configure time)";
+    const std::string why = "not in this build (needs " + k.needs + " support at configure time)";
     r.add({k.name, k.summary, k.traits, [why] { return why; }, [why](Integrator) { return why; },
            [why](const PipelineSetup&) -> std::unique_ptr<Pipeline> { throw std::invalid_argument(why); },
            k.options});
   }
-  for (const auto& e : built.all())
-    if (!r.find(e.name)) r.add(e);
   return r;
 }
 

@@ -13,9 +13,6 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   // mode's own needs are checked when the pipeline is made (they depend on the option).
   auto unavailable = [] { return interop::unavailable(interop::Mode::map); };
   auto unsupported = [](Integrator i) { return interop::hybrid_unsupported(i); };
-  // CUDA forces, a GL update: equal to the CPU within rounding.
-  auto updating_on = [](Engine e) { return PipelineTraits{Engine::cuda, e, true, CpuMatch::rounding}; };
-  const std::vector<std::string> options = {"interop", "force", "tile", "math"};
   // The GL update's buffers (the states the forces read and the accelerations shared with
   // CUDA) and the CUDA force pass's springs.
   auto footprint = [](Update u) {
@@ -28,18 +25,17 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
   auto read_options = [](Update u) {
     return [u](const PipelineOptions& o) { interop::hybrid_options(o, u); };
   };
-  r.add({"hybrid", "CUDA forces into GL buffers, transform feedback update",
-         updating_on(Engine::gl_transform_feedback), unavailable, unsupported,
-         [](const PipelineSetup& s) {
-           return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::transform_feedback));
-         },
-         options, footprint(Update::transform_feedback), read_options(Update::transform_feedback)});
-  r.add({"hybrid-compute", "CUDA forces into GL buffers, compute-shader update",
-         updating_on(Engine::gl_compute), unavailable, unsupported,
-         [](const PipelineSetup& s) {
-           return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
-         },
-         options, footprint(Update::compute), read_options(Update::compute)});
+  r.add(described("hybrid", unavailable, unsupported,
+                  [](const PipelineSetup& s) {
+                    return interop::make_hybrid_pipeline(s,
+                                                         interop::hybrid_options(s.options, Update::transform_feedback));
+                  },
+                  footprint(Update::transform_feedback), read_options(Update::transform_feedback)));
+  r.add(described("hybrid-compute", unavailable, unsupported,
+                  [](const PipelineSetup& s) {
+                    return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
+                  },
+                  footprint(Update::compute), read_options(Update::compute)));
 }
 
 }  // namespace deformlab
