@@ -79,9 +79,10 @@ int experiment_command(const ExperimentArgs& a) {
       SweepOptions o;
       o.calibration = calibration;
       o.max_size = a.max_size;
-      o.on_cell = [](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
+      o.on_cell = [lattice = sweep->lattice](const Cell& c, const nlohmann::json& r, const SweepProgress& p) {
         const int ran = p.done - p.skipped;
-        std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " " << c.label();
+        std::cout << "[" << p.done << "/" << p.total << "] " << c.pipeline << " " << c.integrator << " "
+                  << c.label(lattice);
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
           std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step"

@@ -279,7 +279,12 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   if (j.contains("type")) {
     const auto t = j["type"].is_string() ? j["type"].get<std::string>() : "";
     if (t == "cloth") m.topology = Topology::cloth_grid;
-    else if (t == "lattice") m.topology = Topology::lattice;
+    else if (t == "lattice") {
+      // A layer that makes the model a lattice without a size of its own: the default cube,
+      // not the cloth's rows with one layer.
+      if (m.topology != Topology::lattice && !j.contains("size")) m.nx = m.ny = m.nz = kDefaultLatticeSide;
+      m.topology = Topology::lattice;
+    }
     else if (t == "mesh") m.topology = Topology::general;
     else bad(where + ".type", "expected \"cloth\", \"lattice\" or \"mesh\"");
   }

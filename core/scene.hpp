@@ -47,6 +47,9 @@ struct MeshSpec {
   std::uint64_t seed = 1;   // order "shuffled"
 };
 
+// A lattice's nodes along each axis where a scene makes one without giving its size.
+inline constexpr int kDefaultLatticeSide = 32;
+
 struct ModelSpec {
   Topology topology = Topology::cloth_grid;  // general: a mesh (read or generated)
   int nx = 128, ny = 128, nz = 1;

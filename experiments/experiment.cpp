@@ -83,8 +83,10 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
     }
   }
   x.raw = j;
-  // A sweep without its own integrators reads the experiment's from here: a base's, written in.
+  // A sweep without its own integrators reads the experiment's from here: a base's, written in;
+  // and the same for a lattice's type, which makes its sizes n^3.
   if (!j.contains("integrator")) x.raw["integrator"] = x.integrator;
+  if (x.scene.model.topology == Topology::lattice) x.raw["scene"]["model"]["type"] = "lattice";
   return x;
 }
 

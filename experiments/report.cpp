@@ -109,7 +109,7 @@ void write_setup(Report& r) {
   std::string missing;
   for (const auto& n : xj.value("sweep", json::object()).value("sizes", json::array()))
     if (n.is_number_integer() && !measured.count(n.get<int>()))
-      missing += (missing.empty() ? "" : ", ") + std::to_string(n.get<int>()) + "²";
+      missing += (missing.empty() ? "" : ", ") + size_label(n.get<int>(), r.sweep.lattice);
   if (!missing.empty())
     r.md << "- Not measured yet: " << missing << " (left out by --max-size, or not reached; `deformlab experiment` "
          << "on this folder again runs them and keeps the cells it has)\n";
@@ -187,7 +187,7 @@ void write_our_cells(Report& r, const Table& t, int n, std::vector<plot::Series>
       r.md << " - |";
       continue;
     }
-    const std::string where = c.label + " " + std::to_string(n) + "²";
+    const std::string where = c.label + " " + size_label(n, r.sweep.lattice);
     if ((*cell)["status"] != "ok") {
       r.md << " n/a [" << r.notes.add((*cell)["reason"], where) << "] |";
       continue;
@@ -202,37 +202,48 @@ void write_our_cells(Report& r, const Table& t, int n, std::vector<plot::Series>
   }
 }
 
-// The paper's figure for `pipeline` in the report's table at size `n`, if it has one.
-std::optional<double> paper_figure(const Report& r, const std::string& pipeline, int n) {
-  std::optional<double> f;
+// The paper's column for `pipeline` with integrator `integrator`, if it has one.
+std::optional<paper::Column> paper_column(const Report& r, const std::string& pipeline, const std::string& integrator) {
   for (const auto& pc : paper::columns(r.sweep.paper_table))
-    if (pc.pipeline == pipeline) f = paper::figure(r.sweep.paper_table, pc, n);
-  return f;
+    if (pc.pipeline == pipeline && pc.integrator == integrator) return pc;
+  return std::nullopt;
+}
+
+// The paper's figure for `pipeline` in table `t` (an integrator's) at size `n`, if it has one.
+std::optional<double> paper_figure(const Report& r, const Table& t, const std::string& pipeline, int n) {
+  const std::optional<paper::Column> pc = paper_column(r, pipeline, t.title);
+  return pc ? paper::figure(r.sweep.paper_table, *pc, n) : std::nullopt;
 }
 
 // Our ratio beside the paper's at size `n`, and where both exist, whether its ordering holds.
 void write_ratio_cells(Report& r, const Table& t, const std::vector<paper::Ratio>& rats, int n) {
   for (const auto& ra : rats) {
-    const json* a = r.results.ok(ra.num, t.title, json::object(), n);
-    const json* b = r.results.ok(ra.den, t.title, json::object(), n);
-    const std::optional<double> pa = paper_figure(r, ra.num, n), pb = paper_figure(r, ra.den, n);
+    // A time of a state that went non-finite is the time of a wrong result: not compared.
+    auto stable = [&](const std::string& p) {
+      const json* c = r.results.ok(p, t.title, json::object(), n);
+      return c && c->value("stable", true) ? c : nullptr;
+    };
+    const json *a = stable(ra.num), *b = stable(ra.den);
+    const std::optional<double> pa = paper_figure(r, t, ra.num, n), pb = paper_figure(r, t, ra.den, n);
     const bool here = a && b, there = pa && pb;
     const double q = here ? (*a)["median_ms"].get<double>() / (*b)["median_ms"].get<double>() : 0;
     const double pq = there ? *pa / *pb : 0;
     r.md << " " << (here ? fmt(q) : "n/a") << " | " << (there ? fmt(pq) : "n/a") << " |";
     if (!here || !there) continue;
     const std::string faster = q > 1 ? ra.den + " is faster here" : ra.num + " is faster here";
-    r.reading.push_back(ra.label + " (" + ra.num + " / " + ra.den + ") at " + std::to_string(n) + "²: paper " +
+    r.reading.push_back(ra.label + " (" + ra.num + " / " + ra.den + ") at " + size_label(n, r.sweep.lattice) + ": paper " +
                         fmt(pq) + ", here " + fmt(q) + ": " +
                         ((pq > 1) == (q > 1) ? "the paper's ordering holds" : "the ordering reverses (" + faster + ")"));
   }
 }
 
-// The paper's ratios whose two pipelines are columns of `t` (per-integrator tables only).
+// The paper's ratios whose two pipelines are columns of `t` and of the paper's table for its
+// integrator (per-integrator tables only).
 std::vector<paper::Ratio> ratios_in(const Report& r, const Table& t) {
   auto has_col = [&](const std::string& p) {
-    return std::any_of(t.columns.begin(), t.columns.end(),
-                       [&](const Column& c) { return c.pipeline == p && c.options.empty(); });
+    return paper_column(r, p, t.title) && std::any_of(t.columns.begin(), t.columns.end(), [&](const Column& c) {
+             return c.pipeline == p && c.options.empty();
+           });
   };
   std::vector<paper::Ratio> rats;
   for (const auto& ra : paper::ratios(r.sweep.paper_table))
@@ -258,7 +269,7 @@ void write_table(Report& r, const Table& t) {
   for (const auto& pc : pcols) series.push_back({pc.label, {}, {}, true});
   for (int n : r.results.sizes()) {
     const std::int64_t nodes = r.results.nodes(n);
-    r.md << "| " << n << "² | " << (nodes > 0 ? std::to_string(nodes) : "-") << " |";
+    r.md << "| " << size_label(n, r.sweep.lattice) << " | " << (nodes > 0 ? std::to_string(nodes) : "-") << " |";
     write_our_cells(r, t, n, series);
     for (std::size_t k = 0; k < pcols.size(); ++k) {
       const auto f = paper::figure(r.sweep.paper_table, pcols[k], n);
@@ -278,7 +289,8 @@ void write_table(Report& r, const Table& t) {
   plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes", y, series);
   r.md << "\n![" << t.title << "](" << svg << ")\n\n";
   if (const std::string note = paper::note(r.sweep.paper_table); !note.empty() && !pcols.empty()) r.md << note << "\n\n";
-  if (r.ceil.any() && r.sweep.time == "update") write_ceiling_table(r.md, t.columns, r.results, r.ceil);
+  if (r.ceil.any() && r.sweep.time == "update")
+    write_ceiling_table(r.md, t.columns, r.results, r.ceil, r.sweep.lattice);
 }
 
 void write_frames(Report& r) {

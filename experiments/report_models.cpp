@@ -137,7 +137,7 @@ void write_times(std::ostringstream& md, ModelTable& t, const json* f) {
       const json* c = t.res.find(t.model, o, r.label);
       if (!c) md << " - |";
       else if ((*c)["status"] != "ok")
-        md << " n/a [" << t.notes.add((*c)["reason"], r.label + " " + cell_label(*c)) << "] |";
+        md << " n/a [" << t.notes.add((*c)["reason"], r.label + " " + cell_label(*c, false /* a mesh model's cell */)) << "] |";
       else {
         const double ms = (*c)["median_ms"].get<double>();
         md << " " << fmt(ms);

@@ -32,10 +32,10 @@ std::string options_label(const json& o) {
   return s;
 }
 
-std::string cell_label(const json& c) {
+std::string cell_label(const json& c, bool lattice) {
   std::ostringstream label;  // not string concatenation: GCC 12 warns falsely (-Wrestrict) on that
   if (!c.contains("model")) {
-    label << c["size"].get<int>() << "²";
+    label << size_label(c["size"].get<int>(), lattice);
   } else {
     label << c["model"].get<std::string>();
     if (c.contains("order")) label << " " << c["order"].get<std::string>();

@@ -46,8 +46,8 @@ class Notes {
   std::vector<std::pair<std::string, std::vector<std::string>>> notes_;
 };
 
-// "64²" for a grid cell's result, "sheet-1m rcm" for a mesh model's.
-std::string cell_label(const nlohmann::json& cell);
+// "64²" for a grid cell's result ("16³" on a lattice), "sheet-1m rcm" for a mesh model's.
+std::string cell_label(const nlohmann::json& cell, bool lattice);
 
 // The cells' results by (pipeline, integrator, options, size); a later cell of the same key
 // replaces an earlier one.
@@ -78,7 +78,7 @@ struct Column {
 // Each measured step of `columns` against its ceiling (ceiling / measured); nothing when no
 // column has a ceiling and a measurement.
 void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& columns, const Results& results,
-                         const Ceilings& ceil);
+                         const Ceilings& ceil, bool lattice);
 
 // "Where a step's time goes": per pipeline, integrator and option set whose cells timed
 // their stages, each stage per step against its ceiling, the rest of the step (per hand-off

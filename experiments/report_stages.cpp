@@ -50,12 +50,13 @@ struct Group {
   std::string label, pipeline, integrator;
   std::vector<const json*> rows;
   std::vector<std::string> gpu_stages, host_stages;
+  bool lattice = false;  // its grid cells are lattices
 };
 
-Group group_of(const Cell& c, const std::vector<json>& cells) {
+Group group_of(const Cell& c, const std::vector<json>& cells, bool lattice) {
   std::string label = c.pipeline + " " + c.integrator;
   if (!c.options.empty()) label += " [" + options_label(json(c.options)) + "]";
-  Group g{label, c.pipeline, c.integrator, {}, {}, {}};
+  Group g{label, c.pipeline, c.integrator, {}, {}, {}, lattice};
   for (const auto& r : cells)
     if (r["status"] == "ok" && r.contains("stages") && r["pipeline"] == c.pipeline && r["integrator"] == c.integrator &&
         r["options"] == json(c.options))
@@ -73,7 +74,7 @@ Group group_of(const Cell& c, const std::vector<json>& cells) {
 std::vector<Group> stage_groups(const Sweep& sweep, const std::vector<json>& cells) {
   std::vector<Group> groups;
   for (const auto& c : deformlab::cells(sweep)) {
-    Group g = group_of(c, cells);
+    Group g = group_of(c, cells, sweep.lattice);
     const bool seen = std::any_of(groups.begin(), groups.end(), [&](const Group& e) { return e.label == g.label; });
     if (!seen && !g.rows.empty()) groups.push_back(std::move(g));
   }
@@ -106,8 +107,8 @@ plot::Stack write_stage_row(std::ostringstream& md, const Group& g, const json& 
       if (e["name"] == st) return e["median_ms"].get<double>();
     return std::nullopt;
   };
-  md << "| " << cell_label(r) << " | " << fmt(step) << " |";
-  plot::Stack bar{cell_label(r) + " " + fmt(step) + " ms", {}};
+  md << "| " << cell_label(r, g.lattice) << " | " << fmt(step) << " |";
+  plot::Stack bar{cell_label(r, g.lattice) + " " + fmt(step) + " ms", {}};
   const double adjacency_b = r.contains("model") ? mesh_adjacency_bytes(r["nodes"], r["springs"]) : 0;
   double gpu = 0;
   for (const auto& st : g.gpu_stages) {
@@ -136,7 +137,7 @@ plot::Stack write_stage_row(std::ostringstream& md, const Group& g, const json& 
     if (ceil.floor_us > 0) {
       const bool under = per < ceil.floor_us;
       md << " " << fmt(per / ceil.floor_us) << (under ? " \\*" : "") << " |";
-      if (under) under_floor.push_back(cell_label(r) + ": rest " + percent(100 * rest / step) + " of the step");
+      if (under) under_floor.push_back(cell_label(r, g.lattice) + ": rest " + percent(100 * rest / step) + " of the step");
     }
   }
   md << "\n";
@@ -168,7 +169,7 @@ void write_stage_group(std::ostringstream& md, const fs::path& dir, const std::s
 }  // namespace
 
 void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& columns, const Results& results,
-                         const Ceilings& ceil) {
+                         const Ceilings& ceil, bool lattice) {
   const Bounded b = bounded_columns(columns, results, ceil);
   if (b.columns.empty()) return;
   md << "Against this device's ceilings: the least time a step could take (ms) and the measured step's fraction "
@@ -178,7 +179,7 @@ void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& colu
   for (std::size_t k = 0; k < b.columns.size(); ++k) md << "---|";
   md << "\n";
   for (int n : results.sizes()) {
-    md << "| " << n << "² |";
+    md << "| " << size_label(n, lattice) << " |";
     for (const Column* c : b.columns) {
       const json* r = results.ok(c->pipeline, c->integrator, c->options, n);
       if (!r) {

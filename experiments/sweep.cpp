@@ -38,8 +38,10 @@ std::string Cell::id() const {
   return s;
 }
 
-std::string Cell::label() const {
-  if (model.empty()) return std::to_string(size) + "²";
+std::string size_label(int n, bool lattice) { return std::to_string(n) + (lattice ? "³" : "²"); }
+
+std::string Cell::label(bool lattice) const {
+  if (model.empty()) return size_label(size, lattice);
   return order.empty() ? model : model + " " + order;
 }
 
@@ -75,6 +77,11 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   const std::string w = where + ".sweep";
   if (!j.is_object()) bad(w, "expected an object");
   Sweep s;
+  // The experiment's model type, a base's written in (experiments/experiment.cpp).
+  const json* model = x.contains("scene") && x["scene"].is_object() && x["scene"].contains("model")
+                          ? &x["scene"]["model"]
+                          : nullptr;
+  s.lattice = model && model->is_object() && model->value("type", json()) == "lattice";
   for (const auto& [k, v] : j.items()) {
     if (k == "sizes") {
       if (!v.is_array() || v.empty()) bad(w + ".sizes", "expected a non-empty list of sizes");
@@ -82,6 +89,11 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
         s.sizes.push_back(positive(n, w + ".sizes"));
         if (std::count(s.sizes.begin(), s.sizes.end(), s.sizes.back()) > 1)
           bad(w + ".sizes", "size " + std::to_string(s.sizes.back()) + " is named twice");
+        try {
+          check_node_count(std::pow(double(s.sizes.back()), s.lattice ? 3 : 2));
+        } catch (const std::invalid_argument& e) {
+          bad(w + ".sizes", "size " + size_label(s.sizes.back(), s.lattice) + ": " + e.what());
+        }
       }
     } else if (k == "models") s.models = parse_sweep_models(v, w + ".models");
     else if (k == "orders") s.orders = parse_sweep_orders(v, w + ".orders");

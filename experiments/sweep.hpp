@@ -25,6 +25,7 @@ struct SweepModel {
 
 struct Sweep {
   std::vector<int> sizes;                     // n for an n x n cloth (or n^3 lattice)
+  bool lattice = false;                       // the experiment's model is a lattice (its "scene")
   std::vector<SweepModel> models;             // or mesh models (exactly one of the two)
   std::vector<std::string> orders;            // node orders of the models (empty: each model's own)
   std::vector<std::string> pipelines;
@@ -46,8 +47,11 @@ struct Cell {
   std::string model;  // a mesh model's name
   std::string order;  // its node order ("": the model's own)
   std::string id() const;     // file-name safe, unique within a sweep
-  std::string label() const;  // "64²", "sheet-1m rcm"
+  std::string label(bool lattice) const;  // "64²" ("16³" on a lattice), "sheet-1m rcm"
 };
+
+// Grid size n as a label: "n²" for a cloth, "n³" for a lattice.
+std::string size_label(int n, bool lattice);
 
 std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::string& where);
 std::vector<Cell> cells(const Sweep& s);

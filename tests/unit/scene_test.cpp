@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -94,6 +95,19 @@ TEST(Scene, ALayersSpacingOrWidthReplacesTheOther) {
   Scene t;
   apply_json(t, to_json(s), "t");
   EXPECT_EQ(to_json(t), to_json(s));
+}
+
+// A layer that makes the model a lattice without a size takes the default cube, not the cloth's
+// rows with one layer; a lattice's own size stays through a later layer that names the type again.
+TEST(Scene, ALatticeWithoutASizeIsTheDefaultCube) {
+  Scene s;
+  apply_json(s, json::parse(R"({"model": {"type": "lattice"}})"), "a");
+  EXPECT_EQ(s.model.nx, kDefaultLatticeSide);
+  EXPECT_EQ(s.model.ny, kDefaultLatticeSide);
+  EXPECT_EQ(s.model.nz, kDefaultLatticeSide);
+  apply_json(s, json::parse(R"({"model": {"type": "lattice", "size": [4, 5, 6]}})"), "b");
+  apply_json(s, json::parse(R"({"model": {"type": "lattice"}})"), "c");
+  EXPECT_EQ(std::tuple(s.model.nx, s.model.ny, s.model.nz), std::tuple(4, 5, 6));
 }
 
 // A mesh's masses come from density or node_mass: a later layer's replaces the earlier's, and

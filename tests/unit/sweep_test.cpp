@@ -317,12 +317,77 @@ TEST_F(SweepTest, ModelsByOrders) {
   EXPECT_NE(with.find("at the CUDA copy bandwidth (1000.0 GB/s): 0.000464 ms"), std::string::npos) << with;
 }
 
-// The built-in meshes experiment: 6 models x 4 orders x (7 pipelines + 2 hybrids x 3 force variants).
-// A row's label in the report: the grid size, or the mesh model and its node order.
+// A row's label in the report: the grid size (a lattice's cubed), or the mesh model and its node order.
 TEST(Report, CellLabels) {
-  EXPECT_EQ(report::cell_label(json{{"size", 2048}}), "2048²");
-  EXPECT_EQ(report::cell_label(json{{"model", "sheet-1m"}, {"order", "rcm"}}), "sheet-1m rcm");
-  EXPECT_EQ(report::cell_label(json{{"model", "bunny"}}), "bunny");
+  EXPECT_EQ(report::cell_label(json{{"size", 2048}}, false), "2048²");
+  EXPECT_EQ(report::cell_label(json{{"size", 16}}, true), "16³");
+  EXPECT_EQ(report::cell_label(json{{"model", "sheet-1m"}, {"order", "rcm"}}, false), "sheet-1m rcm");
+  EXPECT_EQ(report::cell_label(json{{"model", "bunny"}}, false), "bunny");
+}
+
+// A lattice's sweep knows its sizes are n^3 nodes, from its own scene or a base's, refuses those
+// past the node limit before any cell runs, and labels its rows n³.
+TEST_F(SweepTest, LatticeSweepsCountAndLabelTheirSizesCubed) {
+  std::ofstream(dir_.string() + "-base.json") << R"({"scene": {"model": {"type": "lattice"}}})";
+  const Experiment x = parse_experiment(R"({"name": "cubes", "base": ")" + dir_.string() + R"(-base.json",
+      "sweep": {"sizes": [3, 4], "pipelines": ["cpu"], "warmup": 1, "steps": 1, "repetitions": 1, "frames": 0}})",
+                                        "cubes.json");
+  fs::remove(dir_.string() + "-base.json");
+  const Sweep s = *parse_sweep(x.raw, "cubes.json");
+  EXPECT_TRUE(s.lattice);
+  EXPECT_EQ(cells(s)[0].label(s.lattice), "3³");
+  ASSERT_EQ(run_sweep(x, s, dir_, {}, json::array()), 2);
+  const std::string md = slurp(write_report(dir_));
+  EXPECT_NE(md.find("| 3³ | 27 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 4³ | 64 |"), std::string::npos) << md;
+  // 1025^3 nodes pass 2^30, where a 1025 x 1025 cloth does not.
+  const Experiment big = parse_experiment(
+      R"({"scene": {"model": {"type": "lattice"}}, "sweep": {"sizes": [4, 1025], "pipelines": ["cpu"]}})", "big.json");
+  try {
+    parse_sweep(big.raw, "big.json");
+    ADD_FAILURE() << "a lattice sweep past 2^30 nodes was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("big.json.sweep.sizes: size 1025³: a model of about"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(parse_sweep(tiny(R"({"sizes": [1025], "pipelines": ["cpu"]})").raw, "tiny")->lattice);
+}
+
+// The paper's ratio columns and reading compare its figures for one integrator (Table 2's:
+// explicit Euler) with ours for that integrator only, and never a time of a state that went
+// non-finite.
+TEST_F(SweepTest, PaperRatiosTakeThePapersIntegratorAndStableCellsOnly) {
+  fs::create_directories(dir_ / "cells");
+  const json experiment = json::parse(R"({"name": "ratios", "integrator": "explicit-euler",
+      "sweep": {"sizes": [64, 128], "pipelines": ["omp", "glsl-tf"], "integrators": ["explicit-euler",
+                "semi-implicit-euler"], "paper_table": "table2"}})");
+  std::ofstream(dir_ / "manifest.json") << json{{"experiment", experiment}}.dump();
+  auto cell = [&](const std::string& p, const std::string& integ, int n, double ms, bool stable) {
+    const std::string id = p + integ + std::to_string(n);
+    std::ofstream(dir_ / "cells" / (id + ".json"))
+        << json{{"id", id},          {"size", n},          {"pipeline", p},    {"integrator", integ},
+                {"options", json::object()}, {"nodes", n * n}, {"status", "ok"}, {"median_ms", ms},
+                {"method", "fixed"}, {"stable", stable}}
+               .dump();
+  };
+  for (const char* integ : {"explicit-euler", "semi-implicit-euler"}) {
+    cell("omp", integ, 64, 10.0, true);
+    cell("glsl-tf", integ, 64, 2.0, true);
+    cell("omp", integ, 128, 40.0, false);
+    cell("glsl-tf", integ, 128, 4.0, true);
+  }
+  const std::string md = slurp(write_report(dir_));
+  const std::size_t semi = md.find("## Integrator `semi-implicit-euler`");
+  ASSERT_NE(semi, std::string::npos) << md;
+  const std::string euler = md.substr(0, semi), other = md.substr(semi, md.find("\n## ", semi) - semi);
+  EXPECT_NE(euler.find("| 64² | 4096 | 10.000 | 2.000 | 99.900 | 4.050 | 2.557 | 1.070 | 5.000 | 93.364 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(euler.find("| 128² | 16384 | 40.000 [1] | 4.000 | "), std::string::npos) << md;
+  EXPECT_NE(euler.find(" | n/a | "), std::string::npos) << "the unstable cell's ratio" << md;
+  EXPECT_EQ(other.find("a/d"), std::string::npos) << "no paper ratio for another integrator" << md;
+  EXPECT_NE(md.find("a/d (omp / glsl-tf) at 64²: paper 93.364, here 5.000"), std::string::npos) << md;
+  EXPECT_EQ(md.find("a/d (omp / glsl-tf) at 128²"), std::string::npos) << md;
 }
 
 // The built-in experiments are the source tree's experiments/*.json, each loading by its name,
