@@ -39,14 +39,31 @@ json read_manifest(const fs::path& dir) {
   }
 }
 
+namespace {
+
+// What `dir` holds by its manifest alone.
+Holds manifest_holds(const fs::path& dir) {
+  const json m = read_manifest(dir);
+  if (!m.is_object() || !m.contains("experiment")) return Holds::nothing;
+  return m["experiment"].is_object() ? Holds::experiment : Holds::run;
+}
+
+}  // namespace
+
 Holds folder_holds(const fs::path& dir) {
   std::error_code ec;
-  const json m = read_manifest(dir);
-  if (m.is_object() && m.contains("experiment")) return m["experiment"].is_object() ? Holds::experiment : Holds::run;
+  if (const Holds h = manifest_holds(dir); h != Holds::nothing) return h;
   return fs::is_directory(dir / "cells", ec) ? Holds::experiment : Holds::nothing;
 }
 
 void require_holds_nothing_but(const fs::path& dir, Holds want) {
+  std::error_code ec;
+  const fs::path at = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  for (fs::path up = at.parent_path(); !ec && up.has_relative_path(); up = up.parent_path())
+    if (const Holds outer = manifest_holds(up); outer != Holds::nothing)
+      throw std::invalid_argument("output folder '" + dir.string() + "' lies inside '" + up.string() + "', which holds " +
+                                  (outer == Holds::run ? "a run's outputs" : "an experiment's results") +
+                                  ": give this " + (want == Holds::run ? "run" : "experiment") + " another --out");
   const Holds has = folder_holds(dir);
   if (has == Holds::nothing || has == want) return;
   throw std::invalid_argument("output folder '" + dir.string() + "' holds " +

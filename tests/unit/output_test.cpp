@@ -254,6 +254,21 @@ TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
   fs::remove(dir / "manifest.json");
   fs::create_directories(dir / "cells");  // a sweep stopped before its manifest
   EXPECT_EQ(folder_holds(dir), Holds::experiment);
+  EXPECT_NO_THROW(require_holds_nothing_but(dir / "cells" / "x", Holds::run)) << "no manifest says so";
+  // Nothing goes inside either: a run into an experiment's cells/ had made its folder unreadable.
+  write(dir / "manifest.json", R"({"experiment": {"name": "quick"}})");
+  for (Holds want : {Holds::run, Holds::experiment}) {
+    EXPECT_THROW(require_holds_nothing_but(dir / "cells", want), std::invalid_argument);
+    EXPECT_THROW(require_holds_nothing_but(dir / "new" / "deeper", want), std::invalid_argument);
+  }
+  fs::remove_all(dir / "cells");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu"})");
+  try {
+    require_holds_nothing_but(dir / "frames", Holds::run);
+    ADD_FAILURE() << "a run inside a run's folder was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lies inside '"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
 }
 
