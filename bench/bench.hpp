@@ -68,9 +68,16 @@ struct BenchOptions {
   std::string csv;  // also write the rows here when set
   // `integrator` parsed; throws std::invalid_argument naming it when unknown.
   Integrator integ() const;
+  // integ(), checked before a bench prints or measures anything: each of `pipelines` runs it,
+  // and check_sizes(sizes, ...) holds. Throws std::invalid_argument at the first that does not.
+  Integrator checked(const std::vector<std::string>& pipelines) const;
   SceneKind scene_kind() const { return idealised ? SceneKind::idealised : SceneKind::paper; }
 };
 void add_bench_options(CLI::App& c, BenchOptions& o);
+// Throws std::invalid_argument, naming `flag`, where a size is named twice, or its scene's model and a state do
+// not fit the host beside the largest host footprint of `pipelines` (BenchScene's check).
+void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKind k,
+                 const std::vector<std::string>& pipelines, Integrator integ);
 void add_warmup_ms(CLI::App& c, BenchOptions& o);
 
 // A GPU bench case starts with warm_up_from_rest(p, m, o.warmup_ms): the device's clock up after

@@ -11,7 +11,7 @@ namespace deformlab::bench {
 namespace {
 
 void run_cpu(const StepOptions& o) {
-  const Integrator integ = o.integ();
+  const Integrator integ = o.checked({"cpu", "omp"});
   const SceneKind kind = o.scene_kind();
   CsvFile csv = open_csv(o.csv, "grid,nodes,pipeline,median_ms,min_ms,p90_ms", kRunColumns);
   std::cout << title("cpu") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"

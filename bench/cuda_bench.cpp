@@ -132,10 +132,14 @@ class Report {
 };
 
 void run_cuda(const CudaOptions& o) {
-  const Integrator integ = o.integ();
-  const SceneKind kind = o.scene_kind();
   std::vector<cuda::Variant> variants;
-  for (const auto& v : o.variants) variants.push_back(parse_variant(v));
+  std::vector<std::string> names;
+  for (const auto& v : o.variants) names.push_back(std::string("cuda-") + cuda::to_string(variants.emplace_back(parse_variant(v))));
+  const Integrator integ = o.checked(names);
+  const SceneKind kind = o.scene_kind();
+  check_sizes("--graph-sizes", o.graph_sizes, SceneKind::idealised, {}, integ);
+  check_sizes("--temporal-sizes", o.temporal_sizes, kind, {}, integ);
+  if (o.tile_size > 0) check_sizes("--tile-size", {o.tile_size}, kind, {}, integ);
   for (const auto& t : o.tiles) cuda::parse_tile(t);  // bad tiles refused before anything runs
   for (const auto& t : o.temporal_tiles)
     if (t != "default") cuda::parse_temporal_tile(t);

@@ -145,7 +145,7 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
 }
 
 void run_gl(const StepOptions& o) {
-  const Integrator integ = o.integ();
+  const Integrator integ = o.checked({"glsl-tf", "glsl-compute"});
   const gl::ContextInfo& ctx = gl::context();
   const SceneKind kind = o.scene_kind();
   CsvFile csv =

@@ -68,7 +68,9 @@ double stage_ms(const Profiler& prof, const char* name) {
 }
 
 void run_hybrid(const HybridOptions& o) {
-  const Integrator integ = o.integ();
+  std::vector<std::string> names = {"hybrid", "hybrid-compute"};
+  if (o.baselines) names.insert(names.end(), {"cuda-fused", "glsl-tf"});
+  const Integrator integ = o.checked(names);
   const gl::ContextInfo& ctx = gl::context();
   const int dev = interop::cuda_device_of_gl();
   const bool gpusync = std::find(o.modes.begin(), o.modes.end(), "external-gpusync") != o.modes.end();

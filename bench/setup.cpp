@@ -72,6 +72,20 @@ const Scene& fitting(const Scene& s, const std::vector<std::string>& names, Inte
 BenchScene::BenchScene(const Scene& s, const std::vector<std::string>& pipelines, Integrator integ)
     : model(build_model(fitting(s, pipelines, integ))), params(resolve_params(s, model)) {}
 
+void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKind k,
+                 const std::vector<std::string>& pipelines, Integrator integ) {
+  for (auto n = sizes.begin(); n != sizes.end(); ++n) {
+    const std::string at = flag + ": size " + std::to_string(*n);
+    if (std::find(sizes.begin(), n, *n) != n) throw std::invalid_argument(at + " is named twice");
+    try {
+      check_node_count(double(*n) * *n);
+      fitting(scene_of(*n, k), pipelines, integ);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(at + ": " + e.what());
+    }
+  }
+}
+
 Stats stats(std::vector<double> ms) {
   if (ms.empty()) return {};
   std::sort(ms.begin(), ms.end());
@@ -108,6 +122,15 @@ Integrator BenchOptions::integ() const {
   const auto i = parse_integrator(integrator);
   if (!i) throw std::invalid_argument("unknown integrator '" + integrator + "' (valid: " + integrator_names() + ")");
   return *i;
+}
+
+Integrator BenchOptions::checked(const std::vector<std::string>& names) const {
+  const Integrator i = integ();
+  for (const std::string& name : names)
+    if (const std::string why = pipelines().find(name)->unsupported(i); !why.empty())
+      throw std::invalid_argument(name + ": " + why);
+  check_sizes("--sizes", sizes, scene_kind(), names, i);
+  return i;
 }
 
 void add_bench_options(CLI::App& c, BenchOptions& o) {

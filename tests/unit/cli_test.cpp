@@ -473,7 +473,7 @@ TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
   if (available_gib() > 50) GTEST_SKIP() << "this host has room for the bench's largest cloth";
   const Result r = run("cpu --sizes 32768 --reps 1 --warmup 0", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err.rfind("deformlab-bench: error: a 32768 x 32768 cloth needs ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.rfind("deformlab-bench: error: --sizes: size 32768: a 32768 x 32768 cloth needs ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(" of host memory for its model and state; "), std::string::npos) << r.err;
 }
 
@@ -499,8 +499,28 @@ TEST_F(Cli, BenchCountsItsPipelinesHostMemory) {
   if (available_gib() > 37 || available_gib() < 16) GTEST_SKIP() << "this host's memory is not between the two needs";
   const Result r = run("cpu --sizes 18000 --reps 1 --warmup 0", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err.rfind("deformlab-bench: error: a model of 324000000 nodes on cpu needs 37.4 GiB of host memory", 0), 0u)
+  EXPECT_EQ(r.err.rfind("deformlab-bench: error: --sizes: size 18000: a model of 324000000 nodes on cpu needs 37.4 GiB "
+                        "of host memory",
+                        0),
+            0u)
       << r.err;
+}
+
+// The bench checks every size and its pipelines' integrator before it prints or times anything:
+// a size past the node limit after one that runs, a size named twice, an integrator a pipeline
+// does not run.
+TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
+  for (const auto& [args, error] :
+       {std::pair{"cpu --reps 1 --warmup 0 --sizes 4 100000", "--sizes: size 100000: a model of about 1e+10 nodes exceeds "
+                                                              "the limit of 2^30 nodes"},
+        std::pair{"cpu --reps 1 --warmup 0 --sizes 4 8 4", "--sizes: size 4 is named twice"},
+        std::pair{"gl --reps 1 --warmup 0 --sizes 4 --integrator backward-euler", "glsl-tf: backward-euler needs"}}) {
+    const Result r = run(args, DEFORMLAB_BENCH_EXE);
+    if (r.err.starts_with("deformlab-bench: error: unknown command 'gl'")) continue;  // a build without OpenGL
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.out, "") << args;
+    EXPECT_EQ(r.err.rfind(std::string("deformlab-bench: error: ") + error, 0), 0u) << args << ": " << r.err;
+  }
 }
 
 // An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (52 GiB on a
