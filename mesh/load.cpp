@@ -36,12 +36,17 @@ namespace {
   bad(file, "assimp: " + why);
 }
 
+// A file name's extension in lower case (".PLY" and ".ply" name one format).
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 // assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
 // file is refused first (the header is text, within its first 64 KiB in any file we know).
 void require_ply_header_end(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".ply") return;
+  if (extension_of(path) != ".ply") return;
   std::ifstream in(path, std::ios::binary);
   std::string head(64 * 1024, '\0');
   in.read(head.data(), std::streamsize(head.size()));
@@ -265,7 +270,7 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   if (size == 0) bad(path, "the file is empty");
   const std::string what = "mesh file '" + path + "'";
   return read_in_child(what, child_read_limits(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
-    if (std::filesystem::path(path).extension() != ".msh") return load_with_assimp(path, read_notes);
+    if (extension_of(path) != ".msh") return load_with_assimp(path, read_notes);
     GmshSession gmsh;
     Mesh m;
     GmshSession::run(what, [&] {
@@ -296,9 +301,18 @@ Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& sa
     gmsh::model::geo::synchronize();
     if (cell_size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", cell_size);
     gmsh::option::setNumber("General.NumThreads", 0);  // all cores
-    gmsh::model::mesh::generate(3);
+    // An open surface bounds no volume: Gmsh then fails ("No elements in volume 1") or makes none.
+    const std::string none = "Gmsh made no tetrahedra (is the surface closed?)";
+    try {
+      gmsh::model::mesh::generate(3);
+    } catch (...) {
+      std::string error;
+      gmsh::logger::getLastError(error);
+      if (error.find("No elements in volume") != std::string::npos) throw std::invalid_argument(none);
+      throw;
+    }
     m = read_gmsh_model("filling the surface with tetrahedra");
-    if (!m.volume()) throw std::invalid_argument("Gmsh made no tetrahedra (is the surface closed?)");
+    if (!m.volume()) throw std::invalid_argument(none);
     if (!save_to.empty()) write_gmsh_model(save_to);
   });
   return m;

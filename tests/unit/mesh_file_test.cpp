@@ -243,6 +243,27 @@ TEST_F(MeshFile, DamagedFilesEndInAMeshOrOneLine) {
   EXPECT_EQ(cut_refused, 20) << "every file cut short is refused";
 }
 
+// An open surface bounds no volume: one line that says so, not Gmsh's own message.
+TEST_F(MeshFile, AnOpenSurfaceIsNotFilled) {
+  Mesh quad;
+  quad.position = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  quad.triangle = {{0, 1, 2}, {0, 2, 3}};
+  try {
+    fill_tetrahedra(quad, 0.f);
+    ADD_FAILURE() << "an open surface was filled";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "Gmsh made no tetrahedra (is the surface closed?)");
+  }
+}
+
+// A Gmsh file is one by its extension in any case.
+TEST_F(MeshFile, AnUpperCaseMshIsGmshs) {
+  const std::string msh = (dir_ / "BOX.MSH").string();
+  write_gmsh_box((dir_ / "box.msh").string(), false);  // Gmsh writes by the extension in lower case
+  fs::rename(dir_ / "box.msh", msh);
+  EXPECT_TRUE(load(msh).volume());
+}
+
 TEST_F(MeshFile, TheBunnyIsClosedAndFillsWithTetrahedra) {
   Mesh surface = load(DEFORMLAB_SOURCE_DIR "/data/bunny/bunny.obj");
   EXPECT_TRUE(repair(surface).empty());
