@@ -223,6 +223,13 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
   return out;
 }
 
+void check_run_names(const RunArgs& a) {
+  const Experiment x = read_experiment(a);
+  const auto integ = parse_integrator(x.integrator);
+  if (!integ) throw BadInput("unknown integrator '" + x.integrator + "' (valid: " + integrator_names() + ")");
+  if (x.pipeline != "best") parse_options(a.options, *find_pipeline(x, *integ));
+}
+
 RunInput read_run_input(const RunArgs& a, Output output) {
   RunInput in;
   in.x = read_experiment(a);

@@ -39,5 +39,9 @@ void require_writable(const std::filesystem::path& out);
 // `run`'s output folder is checked first, before the model is built; `view` writes none.
 enum class Output { folder, none };
 RunInput read_run_input(const RunArgs& a, Output output = Output::folder);
+// The checks of read_run_input that need no GPU: the experiment and scene files, the integrator,
+// a named pipeline and its options, refused as read_run_input refuses them. `view` makes them
+// before it opens its window, so that bad input is named on a machine without a display too.
+void check_run_names(const RunArgs& a);
 
 }  // namespace deformlab::app

@@ -39,6 +39,7 @@ int view_command(const ViewArgs& a) {
     if (a.record && std::filesystem::path(*a.record).extension() != ".mp4")
       throw std::invalid_argument("--record '" + *a.record + "': expected a file name ending in .mp4 (the recording is "
                                   "H.264 in an MP4 file)");
+    check_run_names(a.run);
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;
     o.steps_per_frame = a.steps_per_frame;

@@ -433,9 +433,13 @@ TEST_F(Cli, AFullStandardOutputIsSaid) {
   }
 }
 
-// The viewer checks its flags before it opens a window (no display needed for these).
+// The viewer checks its flags, files and names before it opens a window (no display needed for
+// these).
 TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
   for (const auto& [args, error] : std::vector<std::pair<std::string, std::string>>{
+           {"--pipeline nope", "unknown pipeline 'nope' (valid: best, "},
+           {"--scene " + (dir_ / "none.json").string(), "cannot open scene file '" + (dir_ / "none.json").string()},
+           {"--integrator leap", "unknown integrator 'leap'"},
            {"--steps-per-frame 2147483647", "--steps-per-frame must be in 1 to 10000"},
            {"--size 200x1 --record " + (dir_ / "x.mp4").string(), "--record needs a window 2 pixels high or more"},
            {"--record " + (dir_ / "x.txt").string(), "--record '" + (dir_ / "x.txt").string() +
