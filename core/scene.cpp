@@ -69,6 +69,7 @@ float num(const json& j, const std::string& where, Range r = Range::any) {
 
 int integer(const json& j, const std::string& where, std::int64_t min = INT32_MIN) {
   if (!j.is_number_integer()) bad(where, "expected an integer");
+  if (j.is_number_unsigned() && j.get<std::uint64_t>() > std::uint64_t(INT64_MAX)) bad(where, "integer out of range");
   const auto v = j.get<std::int64_t>();
   if (v < min) bad(where, "expected an integer >= " + std::to_string(min));
   if (v > INT32_MAX) bad(where, "integer out of range");

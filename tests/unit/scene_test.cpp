@@ -172,6 +172,11 @@ TEST(Scene, ErrorsNameTheKey) {
   EXPECT_NE(error_of(R"({"pipeline": 3})").find("x.json.pipeline: expected a string"), std::string::npos);
   EXPECT_NE(error_of("{not json").find("not valid JSON"), std::string::npos);
   EXPECT_NE(error_of(R"({"scene": {"drag": {"path": [[0, 1, 2]]}}})").find("[t, x, y, z]"), std::string::npos);
+  // Past 64 bits: out of range, not wrapped round to a negative count.
+  EXPECT_NE(error_of(R"({"scene": {"max_steps": 18446744073709551615}})").find("x.json.scene.max_steps: integer out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"min_steps": 9223372036854775808}})").find("x.json.scene.min_steps: integer out of range"),
+            std::string::npos);
 }
 
 TEST(Scene, ResolveRejectsBadValues) {
