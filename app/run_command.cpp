@@ -132,11 +132,17 @@ json memory_of(const RunInput& in) {
 struct StepMedians {
   double step_ms, queue_ms;
 };
-StepMedians medians_of(const RunResult& r) {
+// Over the steps whose passes the profiler did not time (its events or queries are device work
+// in the steps it samples), or over every step where it sampled them all (--trace, short runs).
+StepMedians medians_of(const RunResult& r, const Profiler& profiler) {
   std::vector<double> ms, queue;
-  for (const auto& rec : r.records) {
-    ms.push_back(rec.ms);
-    queue.push_back(rec.queue_ms);
+  for (bool all : {false, true}) {
+    for (const auto& rec : r.records)
+      if (all || !profiler.sampled(rec.step)) {
+        ms.push_back(rec.ms);
+        queue.push_back(rec.queue_ms);
+      }
+    if (!ms.empty()) break;
   }
   return {median(ms), median(queue)};
 }
@@ -301,7 +307,7 @@ int run_command(const RunArgs& a) {
     const RunResult& r = ran.result;
     const State final_state = pipe->state();
     const json compare = a.compare ? compare_with_reference(in, final_state, r.steps) : json();
-    const StepMedians med = medians_of(r);
+    const StepMedians med = medians_of(r, profiler);
 
     write_timings_csv(dir.staged("timings.csv"), r);
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());

@@ -51,7 +51,8 @@ class Profiler {
   // always sampled.
   static constexpr int kSampleWindow = 8;
   void sample_every(int windows) { every_ = windows; }
-  bool sampled() const { return every_ <= 1 || step_ <= 0 || (step_ - 1) / kSampleWindow % every_ == 0; }
+  bool sampled() const { return sampled(step_); }
+  bool sampled(int step) const { return every_ <= 1 || step <= 0 || (step - 1) / kSampleWindow % every_ == 0; }
   // What the sampling covers, as a user reads it.
   std::string sampled_steps() const;
   // How many of steps 1..n it samples.

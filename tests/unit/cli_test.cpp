@@ -54,6 +54,28 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".deformlab-staging-" + std::to_string(::getpid()))));
 }
 
+// The step clock's median leaves out the steps whose passes were timed (1-8 of every 64):
+// the median of the other rows of timings.csv, which keeps 9 digits.
+TEST_F(Cli, TheMedianStepLeavesOutTheProfiledSteps) {
+  const fs::path out = dir_ / "run";
+  const Result r = run("run --pipeline cpu --grid 8x6 --steps 150 --no-state --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream csv(slurp(out / "timings.csv"));
+  std::string line;
+  std::getline(csv, line);
+  std::vector<double> unprofiled;
+  while (std::getline(csv, line)) {
+    const int step = std::stoi(line);
+    const std::size_t a = line.find(',', line.find(',') + 1) + 1;
+    if ((step - 1) % 64 >= 8) unprofiled.push_back(std::stod(line.substr(a, line.find(',', a) - a)));
+  }
+  ASSERT_EQ(unprofiled.size(), 150u - 8 - 8 - 8);
+  std::nth_element(unprofiled.begin(), unprofiled.begin() + long(unprofiled.size() / 2), unprofiled.end());
+  const double expected = unprofiled[unprofiled.size() / 2];
+  const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
+  EXPECT_NEAR(m["result"]["median_step_ms"].get<double>(), expected, 1e-8 * expected);
+}
+
 // The node count deformlab mesh prints at the start of its second line ("  N nodes, "), or -1.
 int mesh_nodes(const std::string& out) {
   const std::size_t second_line = out.find("\n  ");
