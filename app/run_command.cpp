@@ -79,13 +79,17 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   if (a.frames) {
     frames.emplace(in.model, dir.staged("frames"), *a.frames, gl::with_obstacles({}, in.params));
     opt.after_step = [&](int step) {
-      if (!frames->due(step)) return;  // a render span per frame, not per step
-      HostSpan span(&profiler, span::render);
+      if (!frames->due(step)) return;  // a frame span per frame, not per step
+      HostSpan span(&profiler, span::frame);
       frames->after_step(pipe, step);
     };
   }
   Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm, clock()};
   if (frames) {
+    {
+      HostSpan span(&profiler, span::frame);
+      frames->write_last(pipe, ran.result.steps);
+    }
     frames->finish(pipe, ran.result.steps);
     ran.frames = frames->manifest();
   }

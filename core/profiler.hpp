@@ -23,7 +23,8 @@ inline constexpr const char* update = "update";
 inline constexpr const char* force_update = "force+update";
 inline constexpr const char* constraints = "constraints";
 inline constexpr const char* reductions = "reductions";
-inline constexpr const char* render = "render";
+// A frame drawn and written out (--frames), on the host clock.
+inline constexpr const char* frame = "frame";
 }  // namespace span
 
 // The median of timings (the upper one of an even count); 0 for none.

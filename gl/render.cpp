@@ -493,8 +493,12 @@ void FrameWriter::after_step(Pipeline& p, int step) {
   if (due(step)) write(p, step);
 }
 
-void FrameWriter::finish(Pipeline& p, int last_step) {
+void FrameWriter::write_last(Pipeline& p, int last_step) {
   if (last_written_ != last_step) write(p, last_step);
+}
+
+void FrameWriter::finish(Pipeline& p, int last_step) {
+  write_last(p, last_step);
   if (frames_ < 2 || std::system("command -v ffmpeg >/dev/null 2>&1") != 0) return;
   const std::string cmd = "ffmpeg -loglevel error -y -framerate 30 -pattern_type glob -i '" + dir_.string() + "/" +
                           kFrameGlob + "' -c:v libx264 -pix_fmt yuv420p '" + dir_.string() + "/" + kFramesMovie + "'";

@@ -139,7 +139,8 @@ TEST(GlErrors, ASoftwareRenderersBuffersAreCountedBeforeTheModelIsBuilt) {
   std::filesystem::remove_all(dir);
 }
 
-// The command end to end: frames every N steps and the final one, committed with the run;
+// The command end to end: frames every N steps and the final one, each a span, committed with
+// the run;
 // the pass's spans in the sampled steps 1-8 of the 12 (every step with --trace).
 TEST(GlCommand, RunWritesFramesAndGlFacts) {
   DEFORMLAB_REQUIRE_GL();
@@ -158,9 +159,10 @@ TEST(GlCommand, RunWritesFramesAndGlFacts) {
   EXPECT_EQ(c.exit_code, 0) << c.output;
   EXPECT_EQ(pass_spans(), 8);
   std::ifstream spans(dir / "out" / "spans.csv");
-  int render_spans = 0;
-  for (std::string line; std::getline(spans, line);) render_spans += line.rfind("render,", 0) == 0;
-  EXPECT_EQ(render_spans, 2) << "one span a frame rendered after a step (5 and 10), none for the steps between";
+  int frame_spans = 0;
+  for (std::string line; std::getline(spans, line);) frame_spans += line.rfind("frame,", 0) == 0;
+  EXPECT_EQ(frame_spans, 3) << "one span a frame drawn and written (5, 10 and the last, 12), none for the steps "
+                               "between";
   for (const char* f : {"frame_000005.png", "frame_000010.png", "frame_000012.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frames" / f)) << f;
   std::ifstream manifest(dir / "out" / "manifest.json");
