@@ -143,15 +143,17 @@ void check_records_fit(const Params& p) {
 // steps): timings.csv 48 a step, spans.csv 108; with --trace spans.csv 229 and trace.json 629;
 // a frame of 1024² pixels 132-146 kB, counted at 100 kB so that the sum stays under the need.
 std::pair<std::int64_t, std::string> output_bytes(const RunArgs& a, const RunInput& in, std::int64_t steps) {
-  std::int64_t need = steps * (a.trace ? 56 + 240 + 640 : 56 + 112);
+  // Per step: a timings row and the spans' rows (GL runs wrote up to 213 bytes), and with
+  // --trace the trace's events; per frame: a 1024 x 1024 PNG (up to 130 kB measured).
+  std::int64_t need = steps * (a.trace ? 56 + 240 + 640 : 56 + 184);
   std::string what = std::to_string(steps) + " steps' timings" + (a.trace ? ", spans and trace" : " and spans");
   if (!a.no_state) {
     need += ply_bytes(in.model);
     what += ", state.ply";
   }
   if (a.frames) {
-    need += (steps / *a.frames + 1) * 100'000;
-    what += ", frames at 100 kB";
+    need += (steps / *a.frames + 1) * 160'000;
+    what += ", frames at 160 kB";
   }
   return {need, what};
 }
