@@ -153,7 +153,7 @@ void run_gl(const StepOptions& o) {
   std::cout << title("gl") << " ms per step (" << o.integrator << "), cloth grid, 12 springs per interior node\n"
             << describe(kind) << "\n"
             << "device: " << ctx.renderer << " (" << ctx.version << ")\n"
-            << "method: " << gl::Timer().method() << " around each step, " << warm_up_words(o)
+            << "method: each step on the " << gl::Timer().method() << "; " << warm_up_words(o)
             << counted(o.warmup, "warm-up step")
             << ", the median of steps timed back to back for about " << fixed(kGpuTimedMs, 0)
             << " ms (at least " << o.reps << ")\n"

@@ -540,6 +540,7 @@ TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
        {std::pair{"cpu --reps 1 --warmup 0 --sizes 4 100000", "--sizes: size 100000: a model of about 1e+10 nodes exceeds "
                                                               "the limit of 2^30 nodes"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 8 4", "--sizes: size 4 is named twice"},
+        std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv ''", "--csv: an empty file name"},
         std::pair{"gl --reps 1 --warmup 0 --sizes 4 --integrator backward-euler", "glsl-tf: backward-euler needs"}}) {
     const Result r = run(args, DEFORMLAB_BENCH_EXE);
     if (r.err.starts_with("deformlab-bench: error: unknown command 'gl'")) continue;  // a build without OpenGL
