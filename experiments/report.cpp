@@ -284,7 +284,8 @@ void write_table(Report& r, const Table& t) {
   const std::string svg = plot_file(t.title);
   std::erase_if(series, [](const plot::Series& s) { return s.x.empty(); });  // no cell measured: no legend entry
   const bool paper = std::any_of(series.begin(), series.end(), [](const plot::Series& s) { return s.dashed; });
-  const std::string y = std::string("ms per step, each on its pipeline's step clock") +
+  const std::string y = (r.sweep.time == "frame" ? std::string("ms per frame (update and a 1024 x 1024 draw)")
+                                                : std::string("ms per step, each on its pipeline's step clock")) +
                         (paper ? " (dashed: paper, ms per frame)" : "");
   plot::loglog(r.dir / svg, r.name + ": " + t.title, "nodes", y, series);
   r.md << "\n![" << t.title << "](" << svg << ")\n\n";

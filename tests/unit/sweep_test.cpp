@@ -353,6 +353,23 @@ TEST_F(SweepTest, LatticeSweepsCountAndLabelTheirSizesCubed) {
   EXPECT_FALSE(parse_sweep(tiny(R"({"sizes": [1025], "pipelines": ["cpu"]})").raw, "tiny")->lattice);
 }
 
+// A sweep timed by the frame labels its plot's axis so.
+TEST_F(SweepTest, AFrameSweepsPlotIsInMsPerFrame) {
+  fs::create_directories(dir_ / "cells");
+  const json experiment = json::parse(R"({"name": "frames", "integrator": "explicit-euler",
+      "sweep": {"sizes": [64], "pipelines": ["omp"], "time": "frame"}})");
+  std::ofstream(dir_ / "manifest.json") << json{{"experiment", experiment}}.dump();
+  std::ofstream(dir_ / "cells" / "omp64.json")
+      << json{{"id", "omp64"},        {"size", 64},           {"pipeline", "omp"}, {"integrator", "explicit-euler"},
+              {"options", json::object()}, {"nodes", 4096}, {"status", "ok"}, {"median_ms", 3.0},
+              {"method", "fixed"}}
+             .dump();
+  write_report(dir_);
+  const std::string svg = slurp(dir_ / "plot-explicit-euler.svg");
+  EXPECT_NE(svg.find("ms per frame (update and a 1024 x 1024 draw)"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find("ms per step"), std::string::npos) << svg;
+}
+
 // The paper's ratio columns and reading compare its figures for one integrator (Table 2's:
 // explicit Euler) with ours for that integrator only, and never a time of a state that went
 // non-finite.
