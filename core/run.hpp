@@ -27,7 +27,9 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i);
 
 // Empty when a step's largest displacement `disp` (Pipeline::max_displacement) is finite and
 // below the runaway limit (runaway_factor x `extent`, the model's Model::extent(), which walks
-// every node: callers take it once), else the message naming the step, what was seen and the bound.
+// every node: callers take it once; `extent` counts as at least 1 mm, so that a model of almost no
+// extent does not take every move for a runaway), else the message naming the step, what was seen
+// and the bound.
 std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t);
 
 class DivergenceError : public std::runtime_error {

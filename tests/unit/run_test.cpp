@@ -128,20 +128,33 @@ TEST(Run, FixedStepCountWithoutTheStopRule) {
   EXPECT_NEAR(pipe->state().t, 37 * double(p.dt), 1e-12);
 }
 
+// The runaway limit: runaway_factor x the model's extent, the extent counted as at least 1 mm;
+// a state that is not finite always.
+TEST(Run, TheRunawayLimitIsTheExtentWithAMillimetreFloor) {
+  const Model m = test::small_cloth(4, 4);
+  Params p = test::small_params();
+  p.runaway_factor = 2.0f;
+  const Integrator i = Integrator::semi_implicit_euler;
+  EXPECT_TRUE(divergence(1.9, 1.0f, m, p, i, 1, 0.0).empty());
+  EXPECT_FALSE(divergence(2.1, 1.0f, m, p, i, 1, 0.0).empty());
+  EXPECT_TRUE(divergence(1.9e-3, 1e-5f, m, p, i, 1, 0.0).empty()) << "below 2 x 1 mm";
+  EXPECT_FALSE(divergence(2.1e-3, 1e-5f, m, p, i, 1, 0.0).empty());
+  EXPECT_FALSE(divergence(std::nan(""), 1.0f, m, p, i, 1, 0.0).empty());
+  EXPECT_FALSE(divergence(INFINITY, 1.0f, m, p, i, 1, 0.0).empty());
+}
+
 TEST(Run, DivergenceIsCaughtAtTheStepItHappens) {
   const Model m = test::small_cloth(10, 10);
   Params p = test::small_params();
   p.dt = float(3 * stability_limit(m, p, Integrator::semi_implicit_euler));
   p.max_steps = 5000;
   for (Integrator integ : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::rk4}) {
-    // Find the first bad step by hand.
+    // Find the first bad step by stepping by hand, each step set against the limit.
     auto probe = make_cpu_pipeline({m, p, integ}, Precision::f32, false);
-    const double runaway = p.runaway_factor * m.extent();
     int first_bad = 0;
     for (int k = 1; k <= p.max_steps && !first_bad; ++k) {
       probe->step();
-      const double d = probe->max_displacement();
-      if (!std::isfinite(d) || d > runaway) first_bad = k;
+      if (!divergence(probe->max_displacement(), m.extent(), m, p, integ, k, 0.0).empty()) first_bad = k;
     }
     ASSERT_GT(first_bad, 0) << info(integ).name << " did not diverge at 3x the limit";
     auto pipe = make_cpu_pipeline({m, p, integ}, Precision::f32, false);
