@@ -1,7 +1,5 @@
 #include "timed_work.hpp"
 
-#include <numeric>
-
 #include "pipeline.hpp"
 #include "profiler.hpp"
 
@@ -23,8 +21,8 @@ double TimedWork::median_ms() const { return median(ms); }
 TimedWork time_back_to_back(StepTimer& t, const std::function<void()>& work, int warmup, int min_calls,
                             const std::string& bus, int multiple, const std::function<void()>& prepare) {
   const std::vector<double> warm = timed_calls(t, work, warmup, prepare);
-  const double mean = warm.empty() ? 0.0 : std::accumulate(warm.begin(), warm.end(), 0.0) / double(warm.size());
-  const int calls = steps_spanning(warm.empty() ? 0.0 : kGpuTimedMs, mean, min_calls, multiple);
+  // The warm-up's median, not its mean: a first call that compiles shaders would cut the span short.
+  const int calls = steps_spanning(warm.empty() ? 0.0 : kGpuTimedMs, median(warm), min_calls, multiple);
   ClockWatch watch(bus);
   TimedWork w;
   w.ms = timed_calls(t, work, calls, prepare);

@@ -106,6 +106,19 @@ TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
   // No warm-up: the calls asked for; slow calls: at least `min_calls`.
   EXPECT_EQ(time_back_to_back(t, [] {}, 0, 7).ms.size(), 7u);
   EXPECT_EQ(time_back_to_back(t, [] {}, 2, 70).ms.size(), 70u);
+  // A first call that takes 1 s (a shader compiled) does not cut the span: 200 ms of 4 ms calls.
+  struct SlowFirstTimer final : StepTimer {
+    int calls = 0, ended = 0;
+    void begin() override {}
+    void end() override { ++ended; }
+    std::vector<double> take() override {
+      std::vector<double> ms;
+      for (; ended > 0; --ended) ms.push_back(calls++ == 0 ? 1000.0 : 4.0);
+      return ms;
+    }
+    std::string clock() const override { return "fixed"; }
+  } slow;
+  EXPECT_EQ(time_back_to_back(slow, [] {}, 3, 5).ms.size(), 50u);
 }
 
 // The clock is watched on the GPU that runs a pipeline: none for the CPU pipelines; where NVML
