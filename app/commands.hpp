@@ -18,6 +18,7 @@ struct RunArgs {
   bool until_converged = false;
   std::optional<std::string> out;
   std::optional<int> frames;     // render a frame every N steps into DIR/frames (GL builds)
+  std::optional<int> energy;     // the state's energies every N steps into DIR/energy.csv
   std::optional<int> gl_device;  // EGL device index for the GL context (GL builds)
   bool trace = false;            // also write trace.json (Chrome trace of the spans)
   bool no_state = false;         // leave out state.ply

@@ -49,6 +49,10 @@ int main(int argc, char** argv) {
   run->add_option("--compare", a.compare, "Also run the double-precision pipeline 'reference' and report the error");
   run->add_option("--out,-o", a.out, "Output folder (default: runs/<experiment name>)");
   run->add_option("--frames", a.frames, "Write a PNG frame every N steps and the final one into DIR/frames (OpenGL)");
+  run->add_option("--energy", a.energy,
+                  "Write the state's energies at the start, every N steps and the last into DIR/energy.csv (each "
+                  "read back from the device)")
+      ->check(deformlab::app::whole_in(1, std::numeric_limits<int>::max()));
   run->add_option("--gl-device", a.gl_device, "EGL device index for OpenGL (default: the first CUDA-capable one)")
       ->check(deformlab::app::whole_in(0, 1023));
   run->add_flag("--trace", a.trace, "Also write trace.json: the steps' stages as a Chrome trace (open in Perfetto)");

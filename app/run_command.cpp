@@ -45,6 +45,7 @@ struct Ran {
   json frames;  // the frames' manifest with --frames, else null
   WarmUp warm_up;
   ClockSummary clock;  // the GPU's clock over the run, on pipelines with a GPU pass
+  std::vector<EnergySample> energy;  // with --energy
 };
 
 // When a convergence run's stop rule starts, in words.
@@ -74,17 +75,33 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   opt.profiler = &profiler;
   ProgressLine progress(in.params.max_steps, in.params.dt, in.until_converged ? in.params.threshold : 0.0);
   if (progress.shown()) opt.progress = std::ref(progress);
+  // --energy: the state read back at the start, every N steps and after the last.
+  std::vector<EnergySample> energies;
+  const auto sample_energy = [&](int step) {
+    const State s = pipe.state();
+    energies.push_back({step, simulated_time_s(step, in.params.dt), energy(in.model, in.params, s)});
+  };
+  if (a.energy) sample_energy(0);
 #if DEFORMLAB_GL_RENDER
   std::optional<gl::FrameWriter> frames;
-  if (a.frames) {
-    frames.emplace(in.model, dir.staged("frames"), *a.frames, gl::with_obstacles({}, in.params));
+  if (a.frames) frames.emplace(in.model, dir.staged("frames"), *a.frames, gl::with_obstacles({}, in.params));
+#else
+  (void)dir;
+#endif
+  if (a.frames || a.energy)
     opt.after_step = [&](int step) {
-      if (!frames->due(step)) return;  // a frame span per frame, not per step
-      HostSpan span(&profiler, span::frame);
-      frames->after_step(pipe, step);
+#if DEFORMLAB_GL_RENDER
+      if (frames && frames->due(step)) {  // a frame span per frame, not per step
+        HostSpan span(&profiler, span::frame);
+        frames->after_step(pipe, step);
+      }
+#endif
+      if (a.energy && step % *a.energy == 0) sample_energy(step);
     };
-  }
-  Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm, clock()};
+  Ran ran{run(pipe, in.model, in.params, opt), nullptr, warm, clock(), {}};
+  if (a.energy && energies.back().step != ran.result.steps) sample_energy(ran.result.steps);
+  ran.energy = std::move(energies);
+#if DEFORMLAB_GL_RENDER
   if (frames) {
     {
       HostSpan span(&profiler, span::frame);
@@ -93,13 +110,8 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
     frames->finish(pipe, ran.result.steps);
     ran.frames = frames->manifest();
   }
-  return ran;
-#else
-  (void)a;
-  (void)dir;
-  RunResult result = run(pipe, in.model, in.params, opt);
-  return {std::move(result), nullptr, warm, clock()};
 #endif
+  return ran;
 }
 
 // The double-precision CPU run of as many steps from rest, and how far `final_state` is from it.
@@ -190,6 +202,13 @@ json manifest_of(const RunArgs& a, const RunInput& in, const Pipeline& pipe, con
       {"machine", machine_info()}};
   if (a.trace) manifest["files"]["trace.json"] = "Chrome trace of the spans (open in Perfetto: ui.perfetto.dev)";
   if (a.no_state) manifest["files"].erase("state.ply");
+  if (!ran.energy.empty()) {
+    const Energy &first = ran.energy.front().e, &last = ran.energy.back().e;
+    manifest["energy"] = {{"every_steps", *a.energy}, {"samples", ran.energy.size()},
+                          {"first_total_J", first.total()}, {"last_total_J", last.total()}};
+    manifest["files"]["energy.csv"] = "the state's energies at step 0, every_steps and the last: step, t_s, "
+                                      "kinetic_J, spring_J, field_J (gravity and wind), total_J";
+  }
   if (!ran.frames.is_null()) {
     manifest["frames"] = ran.frames;
     manifest["files"]["frames/"] = "PNG frames (and frames.mp4 where ffmpeg is installed); see frames";
@@ -264,8 +283,17 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
   if (mem["pipeline_device_bytes"].get<std::int64_t>() > 0)
     std::cout << "; device " << per_node("pipeline_device_bytes") << " ("
               << gib(mem["pipeline_device_bytes"]) << ")";
+  if (!ran.energy.empty()) {
+    const EnergySample &first = ran.energy.front(), &last = ran.energy.back();
+    std::cout << "\n  energy: total " << significant(first.e.total(), 6) << " J at step " << first.step << ", "
+              << significant(last.e.total(), 6) << " J at step " << last.step << " (kinetic "
+              << significant(last.e.kinetic, 4) << ", springs " << significant(last.e.spring, 4) << ", gravity and wind "
+              << significant(last.e.field, 4) << ")"
+              << (on_gpu(*in.entry) ? "; each read back waits for the device, which the step after it takes in" : "");
+  }
   std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
-            << "manifest.json" << (a.trace ? ", trace.json" : "") << (a.frames ? ", frames/" : "") << "}\n";
+            << "manifest.json" << (a.trace ? ", trace.json" : "") << (a.frames ? ", frames/" : "")
+            << (a.energy ? ", energy.csv" : "") << "}\n";
 }
 
 }  // namespace
@@ -279,7 +307,8 @@ int run_command(const RunArgs& a) {
     if (!a.no_state) writes.push_back("state.ply");
     if (a.trace) writes.push_back("trace.json");
     if (a.frames) writes.push_back("frames/");
-    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames/"}, writes);
+    if (a.energy) writes.push_back("energy.csv");
+    OutputDir dir(in.out, {"timings.csv", "spans.csv", "state.ply", "trace.json", "frames/", "energy.csv"}, writes);
     const auto t0 = std::chrono::steady_clock::now();
     auto pipe = in.entry->make({in.model, in.params, in.integ, in.options});
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -314,6 +343,7 @@ int run_command(const RunArgs& a) {
     const StepMedians med = medians_of(r, profiler);
 
     write_timings_csv(dir.staged("timings.csv"), r);
+    if (a.energy) write_energy_csv(dir.staged("energy.csv"), ran.energy);
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
     if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
     json manifest = manifest_of(a, in, *pipe, ran, profiler, med, setup_s);

@@ -155,6 +155,10 @@ std::pair<std::int64_t, std::string> output_bytes(const RunArgs& a, const RunInp
     need += (steps / *a.frames + 1) * 160'000;
     what += ", frames at 160 kB";
   }
+  if (a.energy) {
+    need += (steps / *a.energy + 2) * 120;
+    what += ", energies";
+  }
   return {need, what};
 }
 

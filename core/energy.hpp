@@ -1,5 +1,7 @@
-// Energies of a state, for physics checks: kinetic, spring potential, and the potential of
-// gravity and wind (constant force fields). Pinned nodes carry no kinetic energy.
+// Energies of a state, for physics checks and runs' energy.csv (deformlab run --energy K):
+// kinetic, spring potential, and the potential of gravity and wind (constant force fields).
+// Pinned nodes carry no kinetic energy; the drag handle's spring and the constraints' contacts
+// are not counted.
 #pragma once
 #include "model.hpp"
 #include "params.hpp"
@@ -15,5 +17,12 @@ struct Energy {
 };
 
 Energy energy(const Model& m, const Params& p, const State& s);
+
+// A run's energies after one of its steps (0: the state it starts from).
+struct EnergySample {
+  int step = 0;
+  double t = 0;  // s
+  Energy e;
+};
 
 }  // namespace deformlab

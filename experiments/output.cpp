@@ -343,6 +343,16 @@ void write_ply(const fs::path& file, const Model& m, const State& s) {
   write_file(file.string(), [&](std::ostream& out) { put_ply(out, m, s); }, true);
 }
 
+void write_energy_csv(const fs::path& file, const std::vector<EnergySample>& samples) {
+  write_file(file.string(), [&](std::ostream& out) {
+    out << "step,t_s,kinetic_J,spring_J,field_J,total_J\n";
+    out.precision(12);
+    for (const EnergySample& s : samples)
+      out << s.step << ',' << s.t << ',' << s.e.kinetic << ',' << s.e.spring << ',' << s.e.field << ','
+          << s.e.total() << '\n';
+  });
+}
+
 void write_timings_csv(const fs::path& file, const RunResult& r) {
   write_file(file.string(), [&](std::ostream& out) {
     out << "step,t_s,step_ms,queue_ms,max_displacement_m\n";

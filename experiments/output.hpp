@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/energy.hpp"
 #include "core/model.hpp"
 #include "core/run.hpp"
 #include "core/scene.hpp"
@@ -102,6 +103,8 @@ std::int64_t ply_bytes(const Model& m);
 // step,t_s,step_ms (on the run's step clock),queue_ms (host clock around step()),
 // max_displacement_m (empty where the step was not checked).
 void write_timings_csv(const std::filesystem::path& file, const RunResult& r);
+// step,t_s,kinetic_J,spring_J,field_J,total_J: a row a sample.
+void write_energy_csv(const std::filesystem::path& file, const std::vector<EnergySample>& samples);
 void write_json(const std::filesystem::path& file, const nlohmann::json& j);
 
 // Machine and build facts for manifests.

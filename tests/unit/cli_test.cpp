@@ -54,6 +54,51 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".deformlab-staging-" + std::to_string(::getpid()))));
 }
 
+// --energy K: the state's energies at step 0, every K steps and the last, each row's parts adding
+// up to its total, the manifest's first and last totals those of the file; a cloth released from
+// rest starts with its springs at rest length and no kinetic energy.
+TEST_F(Cli, RunWritesItsEnergiesEveryKSteps) {
+  const fs::path out = dir_ / "run";
+  const Result r = run("run --pipeline cpu --grid 8x6 --steps 130 --energy 50 --no-state --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream csv(slurp(out / "energy.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "step,t_s,kinetic_J,spring_J,field_J,total_J");
+  std::vector<std::vector<double>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    ASSERT_EQ(row.size(), 6u) << line;
+    EXPECT_NEAR(row[2] + row[3] + row[4], row[5], 1e-9 * std::abs(row[5])) << line;
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 4u);
+  const double steps[] = {0, 50, 100, 130};
+  for (std::size_t k = 0; k < rows.size(); ++k) EXPECT_EQ(rows[k][0], steps[k]);
+  EXPECT_EQ(rows[0][2], 0.0) << "from rest";
+  EXPECT_LT(rows[0][3], 1e-9) << "springs at rest length";
+  EXPECT_GT(rows[3][2], 0.0) << "it falls";
+  const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
+  EXPECT_NEAR(m["energy"]["first_total_J"].get<double>(), rows[0][5], 1e-9 * std::abs(rows[0][5]));
+  EXPECT_NEAR(m["energy"]["last_total_J"].get<double>(), rows[3][5], 1e-9 * std::abs(rows[3][5]));
+  EXPECT_NE(r.out.find("energy: total "), std::string::npos) << r.out;
+  // A GPU pipeline's states, read back mid-run, give the CPU's energies: the same bits in exact
+  // math on cuda-fused and a software renderer, within rounding on NVIDIA's GL (1e-4 of the total
+  // bounds it).
+  for (const char* gpu : {"cuda-fused", "glsl-compute"}) {
+    const fs::path at = dir_ / gpu;
+    const Result g = run(std::string("run --pipeline ") + gpu + " --grid 8x6 --steps 130 --energy 50 --no-state --out " +
+                         at.string());
+    if (g.code == 2 && g.err.find("is not available") != std::string::npos) continue;
+    ASSERT_EQ(g.code, 0) << gpu << ": " << g.err;
+    const auto gm = nlohmann::json::parse(slurp(at / "manifest.json"));
+    EXPECT_NEAR(gm["energy"]["last_total_J"].get<double>(), rows[3][5], 1e-4 * std::abs(rows[3][5])) << gpu;
+    EXPECT_EQ(gm["energy"]["samples"], 4) << gpu;
+  }
+}
+
 // The step clock's median leaves out the steps whose passes were timed (1-8 of every 64):
 // the median of the other rows of timings.csv, which keeps 9 digits.
 TEST_F(Cli, TheMedianStepLeavesOutTheProfiledSteps) {
