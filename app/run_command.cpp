@@ -103,7 +103,7 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
   ran.energy = std::move(energies);
 #if DEFORMLAB_GL_RENDER
   if (frames) {
-    {
+    if (!frames->due(ran.result.steps)) {  // else written after that step
       HostSpan span(&profiler, span::frame);
       frames->write_last(pipe, ran.result.steps);
     }
@@ -289,7 +289,9 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
               << significant(last.e.total(), 6) << " J at step " << last.step << " (kinetic "
               << significant(last.e.kinetic, 4) << ", springs " << significant(last.e.spring, 4) << ", gravity and wind "
               << significant(last.e.field, 4) << ")"
-              << (on_gpu(*in.entry) ? "; each read back waits for the device, which the step after it takes in" : "");
+              << (on_gpu(*in.entry) ? "; with --energy each check and each read back waits for the device: time a "
+                                      "run without it"
+                                    : "");
   }
   std::cout << "\n  wrote " << dir.dir().string() << "/{timings.csv, spans.csv, " << (a.no_state ? "" : "state.ply, ")
             << "manifest.json" << (a.trace ? ", trace.json" : "") << (a.frames ? ", frames/" : "")

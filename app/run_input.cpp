@@ -46,6 +46,13 @@ Experiment read_experiment(const RunArgs& a) {
   return x;
 }
 
+// The experiment's integrator.
+Integrator integrator_of(const Experiment& x) {
+  const auto i = parse_integrator(x.integrator);
+  if (!i) throw BadInput("unknown integrator '" + x.integrator + "' (valid: " + integrator_names() + ")");
+  return *i;
+}
+
 // The experiment's pipeline ("best": the best here for `integ`).
 const PipelineEntry* find_pipeline(const Experiment& x, Integrator integ) {
   const PipelineEntry* entry = x.pipeline == "best" ? &best_pipeline(integ) : pipelines().find(x.pipeline);
@@ -141,10 +148,8 @@ void check_records_fit(const Params& p) {
 
 // Bytes a run writes for `steps` steps, and what they are. Measured (cpu, a 128² cloth, 3000
 // steps): timings.csv 48 a step, spans.csv 108; with --trace spans.csv 229 and trace.json 629;
-// a frame of 1024² pixels 132-146 kB, counted at 100 kB so that the sum stays under the need.
+// GL runs' timings and spans up to 213 a step; frames of 1024² pixels 118-146 kB.
 std::pair<std::int64_t, std::string> output_bytes(const RunArgs& a, const RunInput& in, std::int64_t steps) {
-  // Per step: a timings row and the spans' rows (GL runs wrote up to 213 bytes), and with
-  // --trace the trace's events; per frame: a 1024 x 1024 PNG (up to 130 kB measured).
   std::int64_t need = steps * (a.trace ? 56 + 240 + 640 : 56 + 184);
   std::string what = std::to_string(steps) + " steps' timings" + (a.trace ? ", spans and trace" : " and spans");
   if (!a.no_state) {
@@ -231,9 +236,8 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
 
 void check_run_names(const RunArgs& a) {
   const Experiment x = read_experiment(a);
-  const auto integ = parse_integrator(x.integrator);
-  if (!integ) throw BadInput("unknown integrator '" + x.integrator + "' (valid: " + integrator_names() + ")");
-  if (x.pipeline != "best") parse_options(a.options, *find_pipeline(x, *integ));
+  const Integrator integ = integrator_of(x);
+  if (x.pipeline != "best") parse_options(a.options, *find_pipeline(x, integ));
 }
 
 RunInput read_run_input(const RunArgs& a, Output output) {
@@ -246,9 +250,7 @@ RunInput read_run_input(const RunArgs& a, Output output) {
     require_holds_nothing_but(in.out, Holds::run);
     require_writable(in.out);
   }
-  const auto i = parse_integrator(in.x.integrator);
-  if (!i) throw BadInput("unknown integrator '" + in.x.integrator + "' (valid: " + integrator_names() + ")");
-  in.integ = *i;
+  in.integ = integrator_of(in.x);
   in.entry = find_pipeline(in.x, in.integ);
   in.options = parse_options(a.options, *in.entry);
   require_runs(in.entry, in.x, in.integ);

@@ -22,8 +22,8 @@ const char* to_string(Route r) {
 }
 
 void run_draw(const StepOptions& o) {
+  const gl::ContextInfo& ctx = gl::context();  // first: on a software renderer the buffers count as host memory
   const Integrator integ = o.checked({"glsl-compute", "hybrid-compute", "cuda-fused"});
-  const gl::ContextInfo& ctx = gl::context();
   CsvFile csv =
       open_csv(o.csv, "n,pipeline,route,frame_ms,draw_ms,sm_mhz_median,slowed_fraction", kRunColumns);
   std::cout << title("draw") << " GL " << ctx.renderer << "; cloth n x n, " << describe(o.scene_kind())

@@ -76,6 +76,7 @@ void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKi
                  const std::vector<std::string>& pipelines, Integrator integ) {
   for (auto n = sizes.begin(); n != sizes.end(); ++n) {
     const std::string at = flag + ": size " + std::to_string(*n);
+    if (*n < 2) throw std::invalid_argument(at + ": expected 2 or more");
     if (std::find(sizes.begin(), n, *n) != n) throw std::invalid_argument(at + " is named twice");
     try {
       check_node_count(double(*n) * *n);

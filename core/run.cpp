@@ -110,7 +110,8 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   if (!std::isfinite(disp))
     os << "a position or velocity is not finite";
   else
-    os << "a node moved " << disp << " m in one step, more than " << runaway << " m (runaway_factor x model extent)";
+    os << "a node moved " << disp << " m in one step, more than " << runaway
+       << " m (runaway_factor x model extent, the extent counted as at least 1 mm)";
   os << "; " << stability_hint(m, p, i);
   return os.str();
 }

@@ -21,8 +21,10 @@ double TimedWork::median_ms() const { return median(ms); }
 TimedWork time_back_to_back(StepTimer& t, const std::function<void()>& work, int warmup, int min_calls,
                             const std::string& bus, int multiple, const std::function<void()>& prepare) {
   const std::vector<double> warm = timed_calls(t, work, warmup, prepare);
-  // The warm-up's median, not its mean: a first call that compiles shaders would cut the span short.
-  const int calls = steps_spanning(warm.empty() ? 0.0 : kGpuTimedMs, median(warm), min_calls, multiple);
+  // The warm-up's median without its first call, which may compile shaders: that call (or a mean
+  // with it) would cut the span short.
+  const std::vector<double> settled(warm.begin() + (warm.size() > 1 ? 1 : 0), warm.end());
+  const int calls = steps_spanning(warm.empty() ? 0.0 : kGpuTimedMs, median(settled), min_calls, multiple);
   ClockWatch watch(bus);
   TimedWork w;
   w.ms = timed_calls(t, work, calls, prepare);

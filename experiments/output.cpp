@@ -41,10 +41,12 @@ json read_manifest(const fs::path& dir) {
 
 namespace {
 
-// What `dir` holds by its manifest alone.
-Holds manifest_holds(const fs::path& dir) {
+// What `dir` holds by its manifest alone. `written`: only a manifest as deformlab writes it, with
+// the build and the machine that wrote it (a folder above an output may hold another tool's).
+Holds manifest_holds(const fs::path& dir, bool written = false) {
   const json m = read_manifest(dir);
   if (!m.is_object() || !m.contains("experiment")) return Holds::nothing;
+  if (written && !(m.value("build", json()).is_object() && m.value("machine", json()).is_object())) return Holds::nothing;
   return m["experiment"].is_object() ? Holds::experiment : Holds::run;
 }
 
@@ -60,7 +62,7 @@ void require_holds_nothing_but(const fs::path& dir, Holds want) {
   std::error_code ec;
   const fs::path at = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   for (fs::path up = at.parent_path(); !ec && up.has_relative_path(); up = up.parent_path())
-    if (const Holds outer = manifest_holds(up); outer != Holds::nothing)
+    if (const Holds outer = manifest_holds(up, true); outer != Holds::nothing)
       throw std::invalid_argument("output folder '" + dir.string() + "' lies inside '" + up.string() + "', which holds " +
                                   (outer == Holds::run ? "a run's outputs" : "an experiment's results") +
                                   ": give this " + (want == Holds::run ? "run" : "experiment") + " another --out");

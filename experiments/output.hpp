@@ -30,7 +30,8 @@ nlohmann::json read_manifest(const std::filesystem::path& dir);
 enum class Holds { nothing, run, experiment };
 Holds folder_holds(const std::filesystem::path& dir);
 // Throws std::invalid_argument when `dir` holds the other kind of output than `want`, or lies
-// inside a folder whose manifest says it holds either (a run's frames, an experiment's cells).
+// inside a folder whose manifest, as deformlab writes it, says it holds either (a run's frames, an
+// experiment's cells).
 void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 
 // The first entry of the frames folder `frames` that no run writes there (frame_*.png,

@@ -49,6 +49,8 @@ PipelineRegistry build() {
            [why](const PipelineSetup&) -> std::unique_ptr<Pipeline> { throw std::invalid_argument(why); },
            k.options});
   }
+  for (const PipelineEntry& e : built.all())
+    if (!r.find(e.name)) throw std::logic_error("pipeline " + e.name + " is registered but not a kind (core/pipeline_kinds.cpp)");
   return r;
 }
 

@@ -20,8 +20,8 @@ bool on_software_gl(const PipelineEntry& e);
 // ("exact|fast"), which the pipelines that read it accept (tested), or the form of a value
 // ("WxH", "N", "1-8").
 std::string option_values(const PipelineEntry& e, const std::string& name);
-// The first pipeline in order of expected speed that is available here, runs `i` and does not
-// run on a software rasteriser.
+// The first pipeline of the list (PipelineKind's order) that is available here, runs `i` and
+// does not run on a software rasteriser.
 const PipelineEntry& best_pipeline(Integrator i);
 
 }  // namespace deformlab

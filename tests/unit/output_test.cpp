@@ -256,13 +256,16 @@ TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
   EXPECT_EQ(folder_holds(dir), Holds::experiment);
   EXPECT_NO_THROW(require_holds_nothing_but(dir / "cells" / "x", Holds::run)) << "no manifest says so";
   // Nothing goes inside either: a run into an experiment's cells/ had made its folder unreadable.
-  write(dir / "manifest.json", R"({"experiment": {"name": "quick"}})");
+  // Another tool's manifest above an output does not count.
+  write(dir / "manifest.json", R"({"name": "webapp", "experiment": "A/B test 7"})");
+  EXPECT_NO_THROW(require_holds_nothing_but(dir / "runs" / "x", Holds::run));
+  write(dir / "manifest.json", R"({"experiment": {"name": "quick"}, "build": {}, "machine": {}})");
   for (Holds want : {Holds::run, Holds::experiment}) {
     EXPECT_THROW(require_holds_nothing_but(dir / "cells", want), std::invalid_argument);
     EXPECT_THROW(require_holds_nothing_but(dir / "new" / "deeper", want), std::invalid_argument);
   }
   fs::remove_all(dir / "cells");
-  write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu"})");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu", "build": {}, "machine": {}})");
   try {
     require_holds_nothing_but(dir / "frames", Holds::run);
     ADD_FAILURE() << "a run inside a run's folder was taken";

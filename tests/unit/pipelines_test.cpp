@@ -119,6 +119,8 @@ TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
     std::string clock() const override { return "fixed"; }
   } slow;
   EXPECT_EQ(time_back_to_back(slow, [] {}, 3, 5).ms.size(), 50u);
+  slow.calls = 0;
+  EXPECT_EQ(time_back_to_back(slow, [] {}, 2, 5).ms.size(), 50u) << "two warm-up calls";
 }
 
 // The clock is watched on the GPU that runs a pipeline: none for the CPU pipelines; where NVML
