@@ -54,6 +54,21 @@ TEST_F(Cli, RunWritesTimingsStateAndManifest) {
   EXPECT_FALSE(fs::exists(out / (".deformlab-staging-" + std::to_string(::getpid()))));
 }
 
+// A CSV file's header line and its rows of numbers (an empty cell as NaN).
+std::pair<std::string, std::vector<std::vector<double>>> csv_rows(const std::string& text) {
+  std::istringstream csv(text);
+  std::string header, line;
+  std::getline(csv, header);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(cell.empty() ? NAN : std::stod(cell));
+    rows.push_back(row);
+  }
+  return {header, rows};
+}
+
 // --energy K: the state's energies at step 0, every K steps and the last, each row's parts adding
 // up to its total, the manifest's first and last totals those of the file; a cloth released from
 // rest starts with its springs at rest length and no kinetic energy.
@@ -61,18 +76,11 @@ TEST_F(Cli, RunWritesItsEnergiesEveryKSteps) {
   const fs::path out = dir_ / "run";
   const Result r = run("run --pipeline cpu --grid 8x6 --steps 130 --energy 50 --no-state --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  std::istringstream csv(slurp(out / "energy.csv"));
-  std::string line;
-  std::getline(csv, line);
-  EXPECT_EQ(line, "step,t_s,kinetic_J,spring_J,field_J,total_J");
-  std::vector<std::vector<double>> rows;
-  while (std::getline(csv, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-    ASSERT_EQ(row.size(), 6u) << line;
-    EXPECT_NEAR(row[2] + row[3] + row[4], row[5], 1e-9 * std::abs(row[5])) << line;
-    rows.push_back(row);
+  const auto [header, rows] = csv_rows(slurp(out / "energy.csv"));
+  EXPECT_EQ(header, "step,t_s,kinetic_J,spring_J,field_J,total_J");
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.size(), 6u);
+    EXPECT_NEAR(row[2] + row[3] + row[4], row[5], 1e-9 * std::abs(row[5])) << "step " << row[0];
   }
   ASSERT_EQ(rows.size(), 4u);
   const double steps[] = {0, 50, 100, 130};
@@ -105,15 +113,9 @@ TEST_F(Cli, TheMedianStepLeavesOutTheProfiledSteps) {
   const fs::path out = dir_ / "run";
   const Result r = run("run --pipeline cpu --grid 8x6 --steps 150 --no-state --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  std::istringstream csv(slurp(out / "timings.csv"));
-  std::string line;
-  std::getline(csv, line);
-  std::vector<double> unprofiled;
-  while (std::getline(csv, line)) {
-    const int step = std::stoi(line);
-    const std::size_t a = line.find(',', line.find(',') + 1) + 1;
-    if ((step - 1) % 64 >= 8) unprofiled.push_back(std::stod(line.substr(a, line.find(',', a) - a)));
-  }
+  std::vector<double> unprofiled;  // step_ms of steps outside 1-8 of every 64
+  for (const auto& row : csv_rows(slurp(out / "timings.csv")).second)
+    if ((int(row[0]) - 1) % 64 >= 8) unprofiled.push_back(row[2]);
   ASSERT_EQ(unprofiled.size(), 150u - 8 - 8 - 8);
   std::nth_element(unprofiled.begin(), unprofiled.begin() + long(unprofiled.size() / 2), unprofiled.end());
   const double expected = unprofiled[unprofiled.size() / 2];
