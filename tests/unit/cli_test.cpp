@@ -1,9 +1,12 @@
 // The deformlab command end to end: the outputs of a run and what a failed run leaves
 // (bad inputs: bad_input_test.cpp).
 #include <nlohmann/json.hpp>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "cli_support.hpp"
 #include "core/memory.hpp"
