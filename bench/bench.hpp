@@ -22,17 +22,15 @@ enum class SceneKind { paper, idealised };
 const char* to_string(SceneKind k);
 std::string describe(SceneKind k);
 
+// The scene of size n (a size check_sizes took, before the bench began).
 struct BenchScene {
-  // Refused (std::invalid_argument) where the model and a state do not fit the host's memory,
-  // beside the largest host footprint of the `pipelines` named (run with `integ`) where given.
-  BenchScene(int n, SceneKind k, const std::vector<std::string>& pipelines = {},
-             Integrator integ = Integrator::semi_implicit_euler);
+  BenchScene(int n, SceneKind k);
   Model model;
   Params params;
   PipelineSetup setup(Integrator i) const { return {model, params, i}; }
 
  private:
-  BenchScene(const Scene& s, const std::vector<std::string>& pipelines, Integrator integ);
+  explicit BenchScene(const Scene& s);
 };
 
 // Median and spread of a list of timings (ms), and the GPU's clock while they were taken.
@@ -75,7 +73,7 @@ struct BenchOptions {
 };
 void add_bench_options(CLI::App& c, BenchOptions& o);
 // Throws std::invalid_argument, naming `flag`, where a size is named twice, or its scene's model and a state do
-// not fit the host beside the largest host footprint of `pipelines` (BenchScene's check).
+// not fit the host beside the largest host footprint of `pipelines`.
 void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKind k,
                  const std::vector<std::string>& pipelines, Integrator integ);
 void add_warmup_ms(CLI::App& c, BenchOptions& o);

@@ -21,7 +21,7 @@ void run_cpu(const StepOptions& o) {
             << std::setw(8) << "grid" << std::setw(12) << "cpu ms" << std::setw(12) << "omp ms" << std::setw(10)
             << "speed-up" << std::setw(16) << "omp Mnodes/s" << "\n";
   for (int n : o.sizes) {
-    const BenchScene scene(n, kind, {"cpu", "omp"}, integ);
+    const BenchScene scene(n, kind);
     const Model& m = scene.model;
     Stats st[2];
     for (int k = 0; k < 2; ++k) {

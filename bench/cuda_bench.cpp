@@ -135,7 +135,10 @@ class Report {
 void run_cuda(const CudaOptions& o) {
   std::vector<cuda::Variant> variants;
   std::vector<std::string> names;
-  for (const auto& v : o.variants) names.push_back(std::string("cuda-") + cuda::to_string(variants.emplace_back(parse_variant(v))));
+  for (const auto& v : o.variants) {
+    variants.push_back(parse_variant(v));
+    names.push_back(std::string("cuda-") + cuda::to_string(variants.back()));
+  }
   const Integrator integ = o.checked(names);
   const SceneKind kind = o.scene_kind();
   check_sizes("--graph-sizes", o.graph_sizes, SceneKind::idealised, {}, integ);

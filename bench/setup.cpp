@@ -46,15 +46,16 @@ Scene scene_of(int n, SceneKind k) {
 }
 }  // namespace
 
-BenchScene::BenchScene(int n, SceneKind k, const std::vector<std::string>& pipelines, Integrator integ)
-    : BenchScene(scene_of(n, k), pipelines, integ) {}
+BenchScene::BenchScene(int n, SceneKind k) : BenchScene(scene_of(n, k)) {}
+
+BenchScene::BenchScene(const Scene& s) : model(build_model(s)), params(resolve_params(s, model)) {}
 
 namespace {
 
-// The scene, once its model and a state are known to fit beside what the host has left, with
-// the largest host footprint of the pipelines named (an allocation of another pipeline's that
-// fails is reported as out of memory).
-const Scene& fitting(const Scene& s, const std::vector<std::string>& names, Integrator integ) {
+// Throws unless the scene's model and a state fit beside what the host has left, with the
+// largest host footprint of the pipelines named (an allocation of another pipeline's that fails
+// is reported as out of memory).
+void require_fits(const Scene& s, const std::vector<std::string>& names, Integrator integ) {
   const ModelSize size = model_size(s.model);
   const std::int64_t need = model_host_bytes(size) + state_host_bytes(size.nodes);
   if (const auto limit = host_memory_limit(); limit && need > limit->bytes)
@@ -64,13 +65,9 @@ const Scene& fitting(const Scene& s, const std::vector<std::string>& names, Inte
   for (const std::string& name : names)
     if (const std::string why = host_memory_shortfall(size, *pipelines().find(name), integ, {}); !why.empty())
       throw std::invalid_argument(why);
-  return s;
 }
 
 }  // namespace
-
-BenchScene::BenchScene(const Scene& s, const std::vector<std::string>& pipelines, Integrator integ)
-    : model(build_model(fitting(s, pipelines, integ))), params(resolve_params(s, model)) {}
 
 void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKind k,
                  const std::vector<std::string>& pipelines, Integrator integ) {
@@ -80,7 +77,7 @@ void check_sizes(const std::string& flag, const std::vector<int>& sizes, SceneKi
     if (std::find(sizes.begin(), n, *n) != n) throw std::invalid_argument(at + " is named twice");
     try {
       check_node_count(double(*n) * *n);
-      fitting(scene_of(*n, k), pipelines, integ);
+      require_fits(scene_of(*n, k), pipelines, integ);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(at + ": " + e.what());
     }

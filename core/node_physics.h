@@ -69,8 +69,8 @@ DL_FN int grid_node(int i, int j, int k, int nx, int ny) { return (k * ny + j) *
 // j = grid_axis(n, nx, ny), k = grid_axis(n, nx * ny, nz).
 DL_FN int grid_axis(int n, int stride, int size) { return (n / stride) % size; }
 
-// How far a grid node's springs reach along an axis (flexion springs: two nodes; the stencil in
-// core/grid_stencil.hpp, checked against it there).
+// How far a grid node's springs reach along an axis (flexion springs: two nodes; the test of
+// core/grid_stencil.hpp's table checks it).
 #define STENCIL_REACH 2
 
 // Whether every stencil neighbour of node (i, j, k) lies in the grid (layers: the stencil also

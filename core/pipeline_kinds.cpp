@@ -14,10 +14,9 @@ PipelineTraits hybrid(Engine update) { return {Engine::cuda, update, true, CpuMa
 
 // In order of the step times measured at 2048^2 (Table 2 and the cuda-fused and cuda-temporal
 // benches on an H100: cuda-temporal is slower than cuda-fused, faster than the other gathers);
-// the CPU pipelines close the list.
-// The CUDA gathers give the CPU's bits (tests/cuda), the scatter's atomics add a node's forces
-// in any order; the GL pipelines are deterministic and equal to the CPU within rounding (the
-// GPU's arithmetic differs).
+// the CPU pipelines close the list. The CUDA gathers give the CPU's bits (tests/cuda), the
+// scatter's atomics add a node's forces in any order; the GL pipelines are deterministic and
+// equal to the CPU within rounding (the GPU's arithmetic differs).
 std::vector<PipelineKind> make_kinds() {
   const PipelineTraits gather = on(Engine::cuda, CpuMatch::bitwise);
   PipelineTraits grids_gather = gather;

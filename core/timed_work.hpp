@@ -27,8 +27,8 @@ struct TimedWork {
 };
 
 // `work` on `t` (nothing pending): `warmup` calls, then calls back to back spanning about
-// kGpuTimedMs at the warm-up's median call (its first left out), `min_calls` at the least (without a warm-up, `min_calls`),
-// rounded up to a multiple of `multiple`; `prepare` as timed_calls'. The GPU with PCI bus id
+// kGpuTimedMs at the warm-up's median call (its first left out), `min_calls` at the least
+// (without a warm-up, `min_calls`), rounded up to a multiple of `multiple`; `prepare` as timed_calls'. The GPU with PCI bus id
 // `bus` (empty: NVML's first) is watched over the timed calls.
 TimedWork time_back_to_back(StepTimer& t, const std::function<void()>& work, int warmup, int min_calls,
                             const std::string& bus = {}, int multiple = 1,

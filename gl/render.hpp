@@ -112,10 +112,10 @@ class FrameWriter {
  public:
   FrameWriter(const Model& m, std::filesystem::path dir, int every, RenderOptions o = {});
   bool due(int step) const { return step % every_ == 0; }
-  void after_step(Pipeline& p, int step);     // writes a frame when due(step)
+  void after_step(Pipeline& p, int step);       // writes a frame when due(step)
   void write_last(Pipeline& p, int last_step);  // the final frame, if not written
   void finish(Pipeline& p, int last_step);      // write_last, then the MP4
-  nlohmann::json manifest() const;          // frames written, render times, how timed
+  nlohmann::json manifest() const;              // frames written, render times, how timed
 
  private:
   void write(Pipeline& p, int step);
