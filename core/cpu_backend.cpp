@@ -82,6 +82,12 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     constrain_and_commit();
   }
 
+  std::vector<Vec3f> accelerations(const State& s, double t) {
+    set_state(s);
+    force(slots_[0], acc_[0], t);
+    return std::vector<Vec3f>(acc_[0].begin(), acc_[0].end());
+  }
+
   // The passes are timed by the host clock in the profiler's sampled steps.
   void set_profiler(Profiler* p) override { prof_ = p; }
 
@@ -288,6 +294,10 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
 std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p, bool parallel) {
   if (p == Precision::f64) return std::make_unique<CpuPipeline<double>>(s, parallel);
   return std::make_unique<CpuPipeline<float>>(s, parallel);
+}
+
+std::vector<Vec3f> cpu_accelerations(const PipelineSetup& setup, const State& s, double t) {
+  return CpuPipeline<float>(setup, false).accelerations(s, t);
 }
 
 static Footprint cpu_footprint(const ModelSize& m, Integrator i, Precision p) {

@@ -5,6 +5,7 @@
 // reference that tests and `--compare` measure the other pipelines against.
 #pragma once
 #include <memory>
+#include <vector>
 
 #include "pipeline.hpp"
 
@@ -17,6 +18,11 @@ enum class Precision { f32, f64 };
 inline constexpr int kNodesPerThread = 1024;
 
 std::unique_ptr<Pipeline> make_cpu_pipeline(const PipelineSetup& s, Precision p, bool parallel);
+
+// The float CPU pipeline's force pass on its own: the acceleration of every node in state s at
+// time t (the drag target read then), in the pipeline's arithmetic and order. The tests of GPU
+// update passes feed them where a CUDA force pass would.
+std::vector<Vec3f> cpu_accelerations(const PipelineSetup& setup, const State& s, double t);
 
 // Adds `cpu`, `omp` and `reference` (double, OpenMP) to the registry.
 void add_cpu_pipelines(PipelineRegistry& r);

@@ -7,9 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/cpu_backend.hpp"
-#include "core/springs.hpp"
 #include "core/stage.hpp"
-#include "core/step_params.hpp"
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 #include "tests/support/test_states.hpp"
@@ -17,11 +15,11 @@
 namespace deformlab::test {
 namespace {
 
-// Accelerations on the host with the per-node physics (core/node_physics.h), summed in
-// stencil order.
+// Accelerations on the host: the CPU pipeline's force pass (cpu_accelerations) on the state
+// GL wrote.
 class HostForces final : public ForceStage {
  public:
-  HostForces(const Model& m, const Params& p) : m_(m), p_(p) {}
+  explicit HostForces(const PipelineSetup& setup) : setup_(setup) {}
 
   gl::SharedAllocator allocator() {
     return [this](std::size_t bytes, gl::NodeRole) {
@@ -33,24 +31,20 @@ class HostForces final : public ForceStage {
 
   void forces(int src, int, double t) override {
     const auto [x, v] = gl_->slot_buffers(src);
-    const std::size_t n = std::size_t(m_.node_count());
+    const std::size_t n = std::size_t(setup_.model.node_count());
     std::vector<float> xs(4 * n), vs(4 * n), a(4 * n, 0.f);
     gl::read_buffer(x, 0, xs.size() * 4, xs.data());
     gl::read_buffer(v, 0, vs.size() * 4, vs.data());
-    auto at = [](const std::vector<float>& b, int i) { return Vec3f{b[4 * i], b[4 * i + 1], b[4 * i + 2]}; };
-    using P = Physics<float>;
-    const P::StepParams sp = step_params<float>(m_, p_);
-    const Vec3f target = p_.drag.active() ? p_.drag.target(t) : Vec3f{};
-    for (int i = 0; i < int(n); ++i) {
-      const float w = m_.inv_mass[i];
-      Vec3f f{};
-      for_each_link(m_, i, [&](int j, float rest, float k, float kd) {
-        f += P::spring_force(at(xs, i), at(xs, j), at(vs, i), at(vs, j), k, kd, rest);
-      });
-      const Vec3f ai = P::node_acceleration(sp, i, w, at(xs, i), at(vs, i), f, target);
-      a[4 * i] = ai.x;
-      a[4 * i + 1] = ai.y;
-      a[4 * i + 2] = ai.z;
+    State s;
+    for (std::size_t i = 0; i < n; ++i) {
+      s.x.push_back({xs[4 * i], xs[4 * i + 1], xs[4 * i + 2]});
+      s.v.push_back({vs[4 * i], vs[4 * i + 1], vs[4 * i + 2]});
+    }
+    const std::vector<Vec3f> acc = cpu_accelerations(setup_, s, t);
+    for (std::size_t i = 0; i < n; ++i) {
+      a[4 * i] = acc[i].x;
+      a[4 * i + 1] = acc[i].y;
+      a[4 * i + 2] = acc[i].z;
     }
     glNamedBufferSubData(gl_->force_buffer(), 0, GLsizeiptr(a.size() * 4), a.data());
     ++calls;
@@ -59,8 +53,7 @@ class HostForces final : public ForceStage {
   int calls = 0;
 
  private:
-  const Model& m_;
-  const Params& p_;
+  const PipelineSetup& setup_;
   gl::GlPipeline* gl_ = nullptr;
   std::vector<gl::Buffer> buffers_;
 };
@@ -81,7 +74,7 @@ TEST_P(GlUpdatePass, MatchesTheCpuPipeline) {
   const State s0 = perturbed_state(m, 11);
   const int steps = 30;
   const PipelineSetup setup{m, p, c.integrator};
-  HostForces forces(m, p);
+  HostForces forces(setup);
   auto gpu = c.compute ? gl::make_compute_update(setup, forces.allocator()) : gl::make_tf_update(setup, forces.allocator());
   forces.attach(gpu.get());
   gpu->set_state(s0);
