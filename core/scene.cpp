@@ -272,6 +272,11 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
     m.order = *o;
   }
   if (j.contains("seed")) m.seed = std::uint64_t(integer(j["seed"], where + ".seed", 0));
+  // Keys that would do nothing are refused (the writer leaves them out).
+  if (j.contains("cell_size") && !m.fill)
+    bad(where + ".cell_size", "the cell size of a tetrahedral fill, and this mesh is not filled (\"fill\": \"tetrahedra\")");
+  if (j.contains("seed") && m.order != NodeOrder::shuffled)
+    bad(where + ".seed", std::string("seeds the shuffled order, and this mesh's order is ") + to_string(m.order));
 }
 
 void apply_model(ModelSpec& m, const json& j, const std::string& where, const std::string& dir) {
@@ -332,6 +337,9 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
     m.material.node_mass = num(j["node_mass"], where + ".node_mass", Range::positive);
     m.mesh.density = 0.f;
   }
+  for (const char* k : {"stiffness", "damping"})
+    if (mesh && j.contains(k) && j[k].is_object() && j[k].contains("shear"))
+      bad(where + "." + k + ".shear", "a mesh has no shear springs (its edges are structural, its bending springs flexion)");
   if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness", Range::positive);
   if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
@@ -387,6 +395,8 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
       if (k > 0 && !(h.path[k].t > h.path[k - 1].t)) bad(w + "[0]", "keyframe times must increase");
     }
   }
+  if (j.contains("stiffness") && !h.as_spring)
+    bad(where + ".stiffness", "the spring mode's (\"mode\": \"spring\"); the hard mode puts the node on its path");
   // Keys absent keep the scene's: a drag over a scene without one names both.
   if (d.node.kind == NodeSelector::Kind::index && d.node.index < 0)
     bad(where, "needs \"node\" (the scene has no drag node to keep)");
@@ -530,18 +540,21 @@ json to_json(const Scene& s) {
   json model{{"node_mass", m.material.node_mass}, {"stiffness", kinds(m.material.stiffness)},
              {"damping", kinds(m.material.damping)}};
   if (m.topology == Topology::general) {
+    model["stiffness"].erase("shear");
+    model["damping"].erase("shear");
     const MeshSpec& ms = m.mesh;
     json rows = json::array();
     for (int r = 0; r < 3; ++r) rows.push_back({ms.transform[r * 4], ms.transform[r * 4 + 1], ms.transform[r * 4 + 2], ms.transform[r * 4 + 3]});
-    model.update({{"type", "mesh"}, {"scale", v3(ms.scale)}, {"transform", rows}, {"order", to_string(ms.order)},
-                  {"seed", ms.seed}});
+    model.update({{"type", "mesh"}, {"scale", v3(ms.scale)}, {"transform", rows}, {"order", to_string(ms.order)}});
+    if (ms.order == NodeOrder::shuffled) model["seed"] = ms.seed;
     if (const auto& g = ms.generate) {
       const bool sheet = g->kind == MeshShape::Kind::sheet;
       model["generate"] = {{"shape", to_string(g->kind)}, {"cell_size", g->cell_size},
                            {"size", sheet ? json::array({g->size.x, g->size.z}) : v3(g->size)}};
       if (g->threads > 0) model["generate"]["threads"] = g->threads;
     } else {
-      model.update({{"file", ms.file}, {"fill", ms.fill ? "tetrahedra" : "none"}, {"cell_size", ms.cell_size}});
+      model.update({{"file", ms.file}, {"fill", ms.fill ? "tetrahedra" : "none"}});
+      if (ms.fill) model["cell_size"] = ms.cell_size;
     }
     if (ms.density > 0) model["density"] = ms.density, model.erase("node_mass");  // it sets the masses
   } else {
@@ -569,8 +582,9 @@ json to_json(const Scene& s) {
     json path = json::array();
     for (const auto& k : p.drag.path) path.push_back({k.t, k.position.x, k.position.y, k.position.z});
     j["drag"] = {{"node", to_json(s.drag.node)},
-                 {"mode", p.drag.as_spring ? "spring" : "hard"}, {"stiffness", p.drag.stiffness},
+                 {"mode", p.drag.as_spring ? "spring" : "hard"},
                  {"path_is", s.drag.offsets ? "offset" : "position"}, {"path", path}};
+    if (p.drag.as_spring) j["drag"]["stiffness"] = p.drag.stiffness;
   } else {
     j["drag"] = nullptr;
   }

@@ -154,6 +154,7 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
       if (parse_integrator(s.integrators[e]) == i)
         bad(integrators_key, "'" + s.integrators[k] + "' names the integrator '" + s.integrators[e] + "' names");
   }
+  check_models_under_orders(s, w);
   for (const auto& o : s.option_sets)
     for (const auto& [name, value] : o) {
       const bool read = std::any_of(s.pipelines.begin(), s.pipelines.end(), [&, &name = name](const std::string& p) {

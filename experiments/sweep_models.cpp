@@ -17,6 +17,16 @@ namespace {
   throw std::invalid_argument(where + ": " + what);
 }
 
+// The experiment's scene with model `m`; under a sweep's orders its seed is read for the
+// shuffled order (each cell then takes its own).
+Scene model_scene(const Experiment& x, const Sweep& s, const json& m, const std::string& where) {
+  Scene scene = x.scene;
+  scene.model.topology = Topology::general;
+  if (!s.orders.empty()) scene.model.mesh.order = NodeOrder::shuffled;
+  apply_json(scene, {{"model", m}}, where, x.dir);
+  return scene;
+}
+
 }  // namespace
 
 std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& where) {
@@ -34,8 +44,11 @@ std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& whe
       bad(w + ".name", "'" + name + "' holds \"__\", which joins the parts of a cell's name (a cell of another model "
                        "could take the same name)");
     if (!names.insert(name).second) bad(w + ".name", "model '" + name + "' is named twice");
+    // Alone, as under a sweep's orders: its seed read for the shuffled order (model_scene reads
+    // it over the experiment's scene before the first cell).
     Scene probe;
     probe.model.topology = Topology::general;
+    probe.model.mesh.order = NodeOrder::shuffled;
     apply_json(probe, {{"model", e["model"]}}, w);
     if (probe.model.topology != Topology::general) bad(w + ".model.type", "sweep models are meshes (\"type\": \"mesh\")");
     out.push_back({name, e["model"]});
@@ -56,12 +69,22 @@ std::vector<std::string> parse_sweep_orders(const json& j, const std::string& wh
   return out;
 }
 
+void check_models_under_orders(const Sweep& s, const std::string& where) {
+  if (s.orders.empty()) return;
+  const bool shuffled = std::find(s.orders.begin(), s.orders.end(), "shuffled") != s.orders.end();
+  for (std::size_t k = 0; k < s.models.size(); ++k) {
+    const json& m = s.models[k].model;
+    const std::string w = where + ".models[" + std::to_string(k) + "].model";
+    if (m.contains("order")) bad(w + ".order", "the sweep's \"orders\" give every cell its order");
+    if (m.contains("seed") && !shuffled)
+      bad(w + ".seed", "seeds the shuffled order, which the sweep's \"orders\" leave out");
+  }
+}
+
 void require_model_files(const Experiment& x, const Sweep& s, const std::string& where) {
   for (std::size_t k = 0; k < s.models.size(); ++k) {
     const std::string at = where + ".sweep.models[" + std::to_string(k) + "]", w = at + ".model";
-    Scene scene = x.scene;
-    scene.model.topology = Topology::general;
-    apply_json(scene, {{"model", s.models[k].model}}, at, x.dir);
+    Scene scene = model_scene(x, s, s.models[k].model, at);
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
@@ -71,9 +94,7 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
 
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {
   const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == c.model; });
-  Scene scene = x.scene;
-  scene.model.topology = Topology::general;
-  apply_json(scene, {{"model", m->model}}, "sweep.models." + c.model, x.dir);
+  Scene scene = model_scene(x, s, m->model, "sweep.models." + c.model);
   if (!c.order.empty()) scene.model.mesh.order = *parse_node_order(c.order);
   return scene;
 }

@@ -15,6 +15,8 @@ namespace deformlab {
 std::vector<SweepModel> parse_sweep_models(const nlohmann::json& j, const std::string& where);
 // "orders": node order names, distinct.
 std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::string& where);
+// Under "orders" a model gives no order of its own, and a seed only where they name shuffled.
+void check_models_under_orders(const Sweep& s, const std::string& where);
 
 // Throws std::invalid_argument naming the first model whose mesh file is missing or cannot be
 // read and repaired (check_mesh_file; relative files from the experiment's folder; `where`

@@ -179,6 +179,40 @@ TEST(Scene, ErrorsNameTheKey) {
             std::string::npos);
 }
 
+// A key that would do nothing where it is given is refused, and the writer leaves it out, so a
+// scene as recorded reads back.
+TEST(Scene, KeysWithNoEffectAreRefusedAndNotWritten) {
+  const std::string mesh = R"("model": {"type": "mesh", "pins": "none", "file": "m.obj")";
+  EXPECT_NE(error_of(R"({"scene": {)" + mesh + R"(, "cell_size": 0.1}}})").find("scene.model.cell_size: the cell size of a "
+                                                                               "tetrahedral fill"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {)" + mesh + R"(, "order": "rcm", "seed": 3}}})").find("scene.model.seed: seeds the "
+                                                                                        "shuffled order"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {)" + mesh + R"(, "stiffness": {"shear": 3}}}})").find("scene.model.stiffness.shear: "
+                                                                                        "a mesh has no shear springs"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {)" + mesh + R"(, "damping": {"flexion": 1, "shear": 3}}}})").find("damping.shear"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {"drag": {"node": 3, "stiffness": 9, "path": [[0, 0, 0, 0]]}}})").find(
+                "scene.drag.stiffness: the spring mode's"),
+            std::string::npos);
+  // Where they act, the same keys are read: a fill's cell size, a shuffle's seed, one number
+  // for every kind of spring, a spring handle's stiffness.
+  for (const char* ok : {R"(, "fill": "tetrahedra", "cell_size": 0.1)", R"(, "order": "shuffled", "seed": 3)",
+                         R"(, "stiffness": 7, "damping": {"structural": 1, "flexion": 2})"})
+    EXPECT_EQ(error_of(R"({"scene": {)" + mesh + ok + "}}}"), "") << ok;
+  EXPECT_EQ(error_of(R"({"scene": {"drag": {"node": 3, "mode": "spring", "stiffness": 9, "path": [[0, 0, 0, 0]]}}})"), "");
+  Scene s;
+  apply_json(s, json::parse("{" + mesh + R"(, "stiffness": 7}, "drag": {"node": 3, "path": [[0, 0, 0, 0]]}})"), "s", ".");
+  const json j = to_json(s);
+  EXPECT_FALSE(j["model"]["stiffness"].contains("shear"));
+  EXPECT_FALSE(j["model"].contains("seed") || j["model"].contains("cell_size") || j["drag"].contains("stiffness"));
+  Scene t;
+  apply_json(t, j, "t", ".");
+  EXPECT_EQ(to_json(t), j);
+}
+
 TEST(Scene, ResolveRejectsBadValues) {
   Scene s;
   s.model.nx = s.model.ny = 4;
