@@ -48,16 +48,6 @@ struct Ran {
   std::vector<EnergySample> energy;  // with --energy
 };
 
-// When a convergence run's stop rule starts, in words.
-std::string stop_rule_start(const Params& p) {
-  const std::string why = p.drag.active() ? " (min_steps and the drag path's end at t = " +
-                                                significant_trimmed(p.drag.end_time(), 6) + " s)"
-                                          : " (min_steps)";
-  const int step = first_stop_step(p);
-  return step == std::numeric_limits<int>::max() ? "the stop rule starts past the last step an int counts" + why
-                                                  : "the stop rule starts at step " + std::to_string(step) + why;
-}
-
 // Runs the pipeline from rest, after its warm-up, with the profiler attached; with --frames,
 // renders into the staged frames/ folder.
 Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler& profiler, const OutputDir& dir) {
@@ -324,6 +314,9 @@ int run_command(const RunArgs& a) {
       std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
                 << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
                 << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
+    if (in.x.until_converged && !in.until_converged)
+      std::cerr << "deformlab: note: the experiment runs until converged, and --steps makes this a run of "
+                << in.params.max_steps << " steps (with --until-converged as well, they are the most it takes)\n";
     if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
       std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
                 << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";

@@ -14,6 +14,8 @@
 #include <utility>
 
 #include "core/memory.hpp"
+#include "core/number_text.hpp"
+#include "core/run.hpp"
 #include "experiments/output.hpp"
 #include "experiments/pipelines.hpp"
 #include "experiments/sweep.hpp"
@@ -234,6 +236,15 @@ std::vector<int> parse_size(const std::string& s, int dims, const char* flag) {
   return out;
 }
 
+std::string stop_rule_start(const Params& p) {
+  const std::string why = p.drag.active() ? " (min_steps and the drag path's end at t = " +
+                                                significant_trimmed(p.drag.end_time(), 6) + " s)"
+                                          : " (min_steps)";
+  const int step = first_stop_step(p);
+  return step == std::numeric_limits<int>::max() ? "the stop rule starts past the last step an int counts" + why
+                                                  : "the stop rule starts at step " + std::to_string(step) + why;
+}
+
 void check_run_names(const RunArgs& a) {
   const Experiment x = read_experiment(a);
   const Integrator integ = integrator_of(x);
@@ -263,13 +274,12 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   if (a.threshold && !in.until_converged)
     throw BadInput("--threshold applies to a run until converged (--until-converged); this one takes a fixed number "
                    "of steps");
-  if (const Params& p = in.x.scene.params; in.until_converged && a.steps && p.max_steps < p.min_steps)
-    throw BadInput("--steps " + std::to_string(p.max_steps) + " with --until-converged: the stop rule starts at the "
-                   "scene's min_steps (" + std::to_string(p.min_steps) + "), so give at least that many steps");
   check_records_fit(in.x.scene.params);
   if (a.compare && *a.compare != "reference")
     throw BadInput("--compare '" + *a.compare +
                    "': the only pipeline to compare with is 'reference' (double precision)");
+  if (a.compare && in.entry->name == "reference")
+    throw BadInput("--compare reference: the pipeline run is 'reference' itself");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
   if (!mesh && in.options.count("link_view"))
@@ -281,6 +291,9 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   if (mesh) check_fits(in, bool(a.compare), in.model.size());
   in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);
+  if (in.until_converged && a.steps && first_stop_step(in.params) > in.params.max_steps)
+    throw BadInput("--steps " + std::to_string(in.params.max_steps) + " with --until-converged: " +
+                   stop_rule_start(in.params) + ", so give at least that many steps");
   if (output == Output::folder) check_disk_fits(a, in);
   return in;
 }

@@ -43,5 +43,7 @@ RunInput read_run_input(const RunArgs& a, Output output = Output::folder);
 // a named pipeline and its options, refused as read_run_input refuses them. `view` makes them
 // before it opens its window, so that bad input is named on a machine without a display too.
 void check_run_names(const RunArgs& a);
+// When a convergence run's stop rule starts (first_stop_step), in words.
+std::string stop_rule_start(const Params& p);
 
 }  // namespace deformlab::app
