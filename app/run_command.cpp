@@ -314,9 +314,6 @@ int run_command(const RunArgs& a) {
       std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
                 << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
                 << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
-    if (in.x.until_converged && !in.until_converged)
-      std::cerr << "deformlab: note: the experiment runs until converged, and --steps makes this a run of "
-                << in.params.max_steps << " steps (with --until-converged as well, they are the most it takes)\n";
     if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
       std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
                 << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";
