@@ -270,6 +270,11 @@ RunInput read_run_input(const RunArgs& a, Output output) {
     throw BadInput("--gl-device: pipeline '" + in.entry->name + "' runs no OpenGL pass, and no --frames are drawn");
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
+  try {
+    check_options(*in.entry, in.options, in.x.scene.model.topology);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(e.what());
+  }
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   if (a.threshold && !in.until_converged)
     throw BadInput("--threshold applies to a run until converged (--until-converged); this one takes a fixed number "
@@ -282,9 +287,6 @@ RunInput read_run_input(const RunArgs& a, Output output) {
     throw BadInput("--compare reference: the pipeline run is 'reference' itself");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
-  if (!mesh && in.options.count("link_view"))
-    throw BadInput("--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and this "
-                   "model is a grid");
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
   const auto t0 = std::chrono::steady_clock::now();
   in.model = build_model(in.x.scene);

@@ -73,6 +73,12 @@ void check_options(const PipelineEntry& e, const PipelineOptions& o) {
   }
 }
 
+void check_options(const PipelineEntry& e, const PipelineOptions& o, Topology t) {
+  check_options(e, o);
+  if (!e.idle_option) return;
+  if (const std::string why = e.idle_option(o, t); !why.empty()) throw std::invalid_argument(e.name + ": " + why);
+}
+
 void PipelineRegistry::add(PipelineEntry e) {
   if (find(e.name)) throw std::logic_error("pipeline registered twice: " + e.name);
   entries_.push_back(std::move(e));

@@ -131,6 +131,9 @@ struct PipelineEntry {
   // Reads the values of its options, throwing std::invalid_argument at the first it cannot
   // (what depends on the device, such as a GL limit, is checked when the pipeline is made).
   std::function<void(const PipelineOptions&)> read_options = {};
+  // Empty when every option of a readable set acts on a model of this topology, else why the
+  // first does nothing there (a mesh's option on a grid, a thread block where a kernel takes none).
+  std::function<std::string(const PipelineOptions&, Topology)> idle_option = {};
 };
 
 // The entry a backend registers for kind `name`: the kind's name, summary, traits and options,
@@ -139,7 +142,8 @@ PipelineEntry described(const std::string& name, std::function<std::string()> un
                         std::function<std::string(Integrator)> unsupported,
                         std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make,
                         std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint,
-                        std::function<void(const PipelineOptions&)> read_options = {});
+                        std::function<void(const PipelineOptions&)> read_options = {},
+                        std::function<std::string(const PipelineOptions&, Topology)> idle_option = {});
 
 // How `e` run with options `o` compares with the `cpu` pipeline: its trait, or rounding
 // where the options choose fast math.
@@ -148,6 +152,8 @@ CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o);
 // Throws std::invalid_argument, naming `e`, at the first option of `o` that `e` does not read
 // or whose value it cannot read: what a run or a sweep checks before anything runs.
 void check_options(const PipelineEntry& e, const PipelineOptions& o);
+// check_options, then the same for the first option that would do nothing on a model of topology `t`.
+void check_options(const PipelineEntry& e, const PipelineOptions& o, Topology t);
 
 // Empty when a run of `e` on a model of size `m` fits in this machine's host memory, else one
 // line naming the need (the model, the pipeline's own host buffers, a state read back; with a

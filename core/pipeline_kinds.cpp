@@ -73,10 +73,11 @@ PipelineEntry described(const std::string& name, std::function<std::string()> un
                         std::function<std::string(Integrator)> unsupported,
                         std::function<std::unique_ptr<Pipeline>(const PipelineSetup&)> make,
                         std::function<Footprint(const ModelSize&, Integrator, const PipelineOptions&)> footprint,
-                        std::function<void(const PipelineOptions&)> read_options) {
+                        std::function<void(const PipelineOptions&)> read_options,
+                        std::function<std::string(const PipelineOptions&, Topology)> idle_option) {
   const PipelineKind& k = pipeline_kind(name);
-  return {k.name,           k.summary, k.traits, std::move(unavailable), std::move(unsupported), std::move(make),
-          k.options,        std::move(footprint), std::move(read_options)};
+  return {k.name,    k.summary,           k.traits,  std::move(unavailable), std::move(unsupported), std::move(make),
+          k.options, std::move(footprint), std::move(read_options), std::move(idle_option)};
 }
 
 }  // namespace deformlab

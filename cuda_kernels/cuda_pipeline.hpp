@@ -77,6 +77,8 @@ class CudaPipeline : public Pipeline {
 // The registry's options (tile, steps_per_launch, tma, math) as variant v reads them; throws
 // std::invalid_argument on a bad value.
 Options options_of(Variant v, const PipelineOptions& o);
+// Why an option of `o` would do nothing for variant v on a model of topology t, else empty.
+std::string idle_option(Variant v, const PipelineOptions& o, Topology t);
 // Variant v's tile on a model of topology t when none is chosen: 16 x 8, except for
 // cuda-fused: 32 x 8 on cloths (H100, paper scene, explicit Euler, one call, fast math: 0.1056
 // against 0.1076 ms at 2048^2 and 1.540 against 1.633 at 8192^2; exact math within 1% across

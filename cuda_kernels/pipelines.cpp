@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "pipelines.hpp"
 
 #include <stdexcept>
@@ -120,6 +121,20 @@ Options options_of(Variant v, const PipelineOptions& o) {
   return out;
 }
 
+std::string idle_option(Variant v, const PipelineOptions& o, Topology t) {
+  if (v == Variant::temporal && t == Topology::general) return {};  // it runs no mesh, which it says
+  if (const auto it = o.find("tile"); it != o.end()) {
+    if (v == Variant::temporal && t == Topology::cloth_grid && std::count(it->second.begin(), it->second.end(), 'x') == 2)
+      return "option tile '" + it->second + "': a cloth's tile is WxH nodes (WxHxD is a lattice's)";
+    if (v != Variant::tiled && t == Topology::general)
+      return "option tile: on a mesh this pipeline runs one thread per node in blocks of its own (of the CUDA "
+             "pipelines only cuda-tiled takes a tile there: its nodes per tile)";
+  }
+  if (v == Variant::fused && o.count("tma") && t != Topology::cloth_grid)
+    return "option tma: the tensor memory accelerator's kernel is a cloth's";
+  return {};
+}
+
 std::int64_t spring_bytes(const ModelSize& m, Variant v) {
   if (m.grid) return 0;
   // CSR: offsets and two 16-byte links per spring; scatter: 5 words per spring; tiles: the
@@ -187,7 +202,8 @@ void add_cuda_pipelines(PipelineRegistry& r) {
         [v](const ModelSize& m, Integrator i, const PipelineOptions& o) {
           return Footprint{std::int64_t(kTransferChunkNodes) * 16, cuda::bytes_needed(m, i, cuda::options_of(v, o))};
         },
-        [v](const PipelineOptions& o) { cuda::options_of(v, o); }));
+        [v](const PipelineOptions& o) { cuda::options_of(v, o); },
+        [v](const PipelineOptions& o, Topology t) { return cuda::idle_option(v, o, t); }));
 }
 
 }  // namespace deformlab

@@ -163,9 +163,26 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
       });
       if (!read) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
     }
+  // A pipeline runs a set whose every option it reads (cells): one that reads some of a set
+  // would run without it.
+  for (std::size_t k = 0; k < s.option_sets.size(); ++k)
+    for (const auto& p : s.pipelines) {
+      const auto& names = pipelines().find(p)->options;
+      std::string read, unread;
+      for (const auto& [name, value] : s.option_sets[k]) {
+        std::string& list = std::find(names.begin(), names.end(), name) != names.end() ? read : unread;
+        list += (list.empty() ? "" : ", ") + name;
+      }
+      if (!read.empty() && !unread.empty())
+        bad(w + ".options[" + std::to_string(k) + "]",
+            p + " reads " + read + " but not " + unread + ", so it would run without this set (a pipeline runs the "
+            "sets whose every option it reads: give it a set of its own)");
+    }
+  // Each cell's options as its model reads them: the sweep's grids (its scene's topology) or meshes.
   for (const Cell& c : cells(s))
     try {
-      check_options(*pipelines().find(c.pipeline), c.options);
+      check_options(*pipelines().find(c.pipeline), c.options,
+                    !c.model.empty() ? Topology::general : s.lattice ? Topology::lattice : Topology::cloth_grid);
     } catch (const std::invalid_argument& e) {
       bad(w + ".options", e.what());
     }

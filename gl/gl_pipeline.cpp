@@ -95,6 +95,12 @@ void read_options(const PipelineOptions& o) {
       throw std::invalid_argument(std::string("option ") + name + " '" + it->second + "' is not a count of 1 or more");
 }
 
+std::string idle_option(const PipelineOptions& o, Topology t) {
+  if (o.count("link_view") && t != Topology::general)
+    return "option link_view: a mesh's option (links per texture-buffer view of its adjacency), and this model is a grid";
+  return {};
+}
+
 Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
   const Schedule s = make_schedule(i);
   const std::int64_t n = m.nodes, node_buffers = 4 + (s.rule == UpdateRule::verlet ? 2 : 0) + 3 * s.stage_states +

@@ -64,6 +64,8 @@ std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::in
 // Reads the options' values as far as they do not depend on the GL context (PipelineEntry::
 // read_options): math, memory, and window and link_view as counts.
 void read_options(const PipelineOptions& o);
+// Why an option of `o` would do nothing on a model of topology t (link_view on a grid), else empty.
+std::string idle_option(const PipelineOptions& o, Topology t);
 
 // Host and GPU bytes of a GL pipeline beyond the model (with an outside force stage: its
 // accelerations buffer too).

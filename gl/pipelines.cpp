@@ -21,10 +21,10 @@ void add_gl_pipelines(PipelineRegistry& r, const gl::CudaMemory& cuda) {
   };
   r.add(described("glsl-compute", unavailable, unsupported,
                   [cuda](const PipelineSetup& s) { return gl::make_compute_pipeline(s, cuda); }, footprint,
-                  gl::read_options));
+                  gl::read_options, gl::idle_option));
   r.add(described("glsl-tf", unavailable, unsupported,
                   [cuda](const PipelineSetup& s) { return gl::make_tf_pipeline(s, cuda); }, footprint,
-                  gl::read_options));
+                  gl::read_options, gl::idle_option));
 }
 
 }  // namespace deformlab

@@ -31,6 +31,9 @@ Mode default_mode();
 HybridOptions hybrid_options(const PipelineOptions& o, Update u);
 // Empty when the integrator runs on the hybrid pipelines, else why not.
 std::string hybrid_unsupported(Integrator i);
+// Why an option of `o` would do nothing on a model of topology t (a tile where the force pass
+// takes none), else empty.
+std::string hybrid_idle_option(const PipelineOptions& o, Topology t);
 // Throws std::invalid_argument naming what is missing (CUDA, GL, the interop mode's needs).
 std::unique_ptr<Pipeline> make_hybrid_pipeline(const PipelineSetup& s, const HybridOptions& o);
 

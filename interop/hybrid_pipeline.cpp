@@ -40,6 +40,16 @@ std::string hybrid_unsupported(Integrator i) {
   return {};
 }
 
+std::string hybrid_idle_option(const PipelineOptions& o, Topology t) {
+  if (!o.count("tile")) return {};
+  const cuda::Variant force = hybrid_options(o, Update::compute).force;
+  if (force == cuda::Variant::scatter)
+    return "option tile: the scatter force pass (force=scatter) runs one thread per spring in blocks of its own";
+  if (force != cuda::Variant::tiled && t == Topology::general)
+    return "option tile: on a mesh only the tiled force pass (force=tiled) takes a tile, its nodes per tile";
+  return {};
+}
+
 namespace {
 
 // The CUDA force stage and the GL update stage run by the schedule: each force pass hands the

@@ -30,12 +30,13 @@ void add_hybrid_pipelines(PipelineRegistry& r) {
                     return interop::make_hybrid_pipeline(s,
                                                          interop::hybrid_options(s.options, Update::transform_feedback));
                   },
-                  footprint(Update::transform_feedback), read_options(Update::transform_feedback)));
+                  footprint(Update::transform_feedback), read_options(Update::transform_feedback),
+                  interop::hybrid_idle_option));
   r.add(described("hybrid-compute", unavailable, unsupported,
                   [](const PipelineSetup& s) {
                     return interop::make_hybrid_pipeline(s, interop::hybrid_options(s.options, Update::compute));
                   },
-                  footprint(Update::compute), read_options(Update::compute)));
+                  footprint(Update::compute), read_options(Update::compute), interop::hybrid_idle_option));
 }
 
 }  // namespace deformlab

@@ -99,8 +99,8 @@ TEST(GlErrors, BadOptionValuesAreBadInput) {
     std::vector<std::pair<std::string, std::string>> cases = {
         {"math=foo", std::string(name) + ": option math 'foo' is not exact or fast\n"},
         {"memory=host", std::string(name) + ": option memory 'host' is not one of gl, cuda\n"},
-        {"link_view=4", "--option link_view: a mesh's option (links per texture-buffer view of its adjacency), and "
-                        "this model is a grid\n"}};
+        {"link_view=4", std::string(name) + ": option link_view: a mesh's option (links per texture-buffer view of "
+                        "its adjacency), and this model is a grid\n"}};
     if (gl::context().software) cases.push_back({"memory=cuda", std::string(name) + ": memory cuda is not available: "});
     for (const auto& [option, error] : cases) {
       const auto dir = temp_dir("option");

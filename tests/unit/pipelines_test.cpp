@@ -203,6 +203,53 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
   }
 }
 
+// An option that would do nothing on the run's model is refused with the pipeline's name: a
+// mesh's option on a grid, a thread block where the kernels take none, a tile's depth on a cloth.
+TEST(Pipelines, OptionsThatWouldDoNothingOnTheModelAreRefused) {
+  const PipelineRegistry& r = pipelines();
+  const auto refusal = [&](const char* pipeline, const PipelineOptions& o, Topology t) {
+    try {
+      check_options(*r.find(pipeline), o, t);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const Topology cloth = Topology::cloth_grid, lattice = Topology::lattice, mesh = Topology::general;
+  int checked = 0;
+  const auto idle = [&](const char* pipeline, const PipelineOptions& o, Topology t, const std::string& why) {
+    if (!r.find(pipeline)->idle_option) return;
+    ++checked;
+    EXPECT_EQ(refusal(pipeline, o, t), why.empty() ? "" : std::string(pipeline) + ": option " + why) << pipeline;
+  };
+  for (const char* gl : {"glsl-tf", "glsl-compute"}) {
+    idle(gl, {{"link_view", "64"}}, cloth, "link_view: a mesh's option (links per texture-buffer view of its "
+                                           "adjacency), and this model is a grid");
+    idle(gl, {{"link_view", "64"}}, mesh, "");
+  }
+  const std::string block = "tile: on a mesh this pipeline runs one thread per node in blocks of its own (of the "
+                            "CUDA pipelines only cuda-tiled takes a tile there: its nodes per tile)";
+  for (const char* cuda : {"cuda-naive", "cuda-fused"}) {
+    idle(cuda, {{"tile", "16x8"}}, mesh, block);
+    idle(cuda, {{"tile", "16x8"}}, lattice, "");
+  }
+  idle("cuda-tiled", {{"tile", "16x8"}}, mesh, "");
+  idle("cuda-fused", {{"tma", "off"}}, lattice, "tma: the tensor memory accelerator's kernel is a cloth's");
+  idle("cuda-fused", {{"tma", "off"}}, cloth, "");
+  idle("cuda-temporal", {{"tile", "8x8x4"}}, cloth, "tile '8x8x4': a cloth's tile is WxH nodes (WxHxD is a lattice's)");
+  idle("cuda-temporal", {{"tile", "8x8x4"}}, lattice, "");
+  idle("cuda-temporal", {{"tile", "8x8"}}, cloth, "");
+  for (const char* hybrid : {"hybrid", "hybrid-compute"}) {
+    idle(hybrid, {{"tile", "16x8"}, {"force", "scatter"}}, cloth,
+         "tile: the scatter force pass (force=scatter) runs one thread per spring in blocks of its own");
+    idle(hybrid, {{"tile", "16x8"}}, mesh, "tile: on a mesh only the tiled force pass (force=tiled) takes a tile, its "
+                                           "nodes per tile");
+    idle(hybrid, {{"tile", "16x8"}, {"force", "tiled"}}, mesh, "");
+    idle(hybrid, {{"tile", "16x8"}}, cloth, "");
+  }
+  if (checked == 0) GTEST_SKIP() << "this build has no GPU backend, whose options depend on the model";
+}
+
 // The check before a run adds the model, the pipeline's own host bytes and a state, and names
 // the limit that refuses it; grids cost the same whatever their spring count.
 TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {

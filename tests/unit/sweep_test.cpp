@@ -317,6 +317,21 @@ TEST_F(SweepTest, ModelsByOrders) {
   EXPECT_NE(with.find("at the CUDA copy bandwidth (1000.0 GB/s): 0.000464 ms"), std::string::npos) << with;
 }
 
+// A cell's options are checked on its model before the first cell runs: a mesh's option on the
+// sweep's grids is refused, as a run refuses it.
+TEST(Sweep, OptionsThatWouldDoNothingOnTheCellsModelAreRefused) {
+  if (!pipelines().find("glsl-tf")->idle_option) GTEST_SKIP() << "this build has no GL backend";
+  const Experiment x = parse_experiment(R"({"name": "t", "sweep": {"sizes": [8], "pipelines": ["glsl-tf"],
+                                            "options": [{"link_view": "64"}]}})", "t.json");
+  try {
+    parse_sweep(x.raw, "t.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "t.json.sweep.options: glsl-tf: option link_view: a mesh's option (links per "
+                                     "texture-buffer view of its adjacency), and this model is a grid");
+  }
+}
+
 // A row's label in the report: the grid size (a lattice's cubed), or the mesh model and its node order.
 TEST(Report, CellLabels) {
   EXPECT_EQ(report::cell_label(json{{"size", 2048}}, false), "2048²");
@@ -423,8 +438,11 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
   std::set<std::string> swept;
   std::stringstream sweeps(builtin_experiment_names(true));
   for (std::string n; std::getline(sweeps >> std::ws, n, ',');) swept.insert(n);
-  for (const std::string& n : files)
-    EXPECT_EQ(swept.count(n), std::size_t(load_experiment_by_name(n).raw.contains("sweep"))) << n;
+  for (const std::string& n : files) {
+    const Experiment x = load_experiment_by_name(n);
+    EXPECT_EQ(swept.count(n), std::size_t(x.raw.contains("sweep"))) << n;
+    EXPECT_NO_THROW(parse_sweep(x.raw, n)) << n << ": its sweep reads";
+  }
   EXPECT_EQ(swept.count("paper-drag"), 0u);
 }
 
