@@ -195,8 +195,14 @@ bool runs(const PipelineEntry& e, int s) {
   return !e.traits.grids_only || (!kShapes[s].general && kShapes[s].mesh == Shape::grid);
 }
 
+Topology topology(const Shape& s) {
+  if (s.general || s.mesh != Shape::grid) return Topology::general;
+  return s.nz > 0 ? Topology::lattice : Topology::cloth_grid;
+}
+
 // The registry's pipelines x the integrators each runs x the shapes, with default options;
-// each non-default option value on its integrators and shapes.
+// each non-default option value on its integrators and shapes, where it acts (a run refuses
+// one that would do nothing on the model: check_options).
 std::vector<Case> cases() {
   std::vector<Case> out;
   for (const PipelineEntry& e : pipelines().all()) {
@@ -217,7 +223,8 @@ std::vector<Case> cases() {
           for (int s : shapes) {
             PipelineOptions o = with;
             o[option] = v;
-            if (runs(e, s) && e.unsupported(i).empty()) out.push_back({e.name, i, s, o});
+            const bool idle = e.idle_option && !e.idle_option(o, topology(kShapes[s])).empty();
+            if (runs(e, s) && e.unsupported(i).empty() && !idle) out.push_back({e.name, i, s, o});
           }
     }
   }
