@@ -112,7 +112,12 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
           bad(w + ".options", "an option set is named twice");
         s.option_sets.push_back(po);
       }
-    } else if (k == "warmup") s.warmup = positive(v, w + ".warmup");
+    } else if (k == "warmup") {
+      s.warmup = positive(v, w + ".warmup");
+      if (s.warmup < kBoundingSteps)
+        bad(w + ".warmup", "expected at least " + std::to_string(kBoundingSteps) +
+                               " warm-up steps (a cell's first two steps bound its time before it is measured)");
+    }
     else if (k == "steps") s.steps = positive(v, w + ".steps");
     else if (k == "repetitions") s.repetitions = positive(v, w + ".repetitions");
     else if (k == "cell_limit_s") {

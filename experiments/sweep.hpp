@@ -17,6 +17,11 @@
 
 namespace deformlab {
 
+// A cell's first two steps, the second timed, bound its time before it is measured (the first
+// carries one-time costs: shader compiles, first touches of the buffers); a sweep's warm-up
+// counts them.
+constexpr int kBoundingSteps = 2;
+
 // A mesh model of a sweep: a scene "model" object applied over the experiment's model.
 struct SweepModel {
   std::string name;  // letters, digits, '-', '_' and '.'
@@ -31,7 +36,7 @@ struct Sweep {
   std::vector<std::string> pipelines;
   std::vector<std::string> integrators;       // default: the experiment's integrator
   std::vector<PipelineOptions> option_sets;   // each pipeline runs those whose names it reads
-  int warmup = 5;                             // untimed steps per cell
+  int warmup = 5;                             // untimed steps per cell, the kBoundingSteps among them
   int steps = 10;                             // steps per timed batch
   int repetitions = 5;                        // timed batches; the cell reports their median
   double cell_limit_s = 120;                  // a cell expected to take longer is cut (n/a)

@@ -103,10 +103,7 @@ class CellSteps {
 #endif
 };
 
-// Two steps first, the second timed: it bounds the cell's time before committing to it (the
-// first carries one-time costs: shader compiles, first touches of the buffers). Returns why
-// the cell is cut, else "".
-constexpr int kBoundingSteps = 2;
+// The kBoundingSteps: returns why the cell is cut, else "".
 std::string cut_after_second_step(CellSteps& steps, const Sweep& s, int per_batch) {
   steps.step();
   steps.finish();

@@ -11,8 +11,19 @@ namespace deformlab {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+namespace {
+// The scene as its cells take it: a fixed number of steps (no stop rule, no runaway check) and,
+// on a sweep of sizes, each cell's own size.
+json measured_scene(const Experiment& x, const Sweep& s) {
+  json j = to_json(x.scene);
+  for (const char* k : {"threshold", "min_steps", "max_steps", "check_every", "runaway_factor"}) j.erase(k);
+  if (!s.sizes.empty()) j["model"].erase("size");
+  return j;
+}
+}  // namespace
+
 json measurement(const Experiment& x, const Sweep& s) {
-  return {{"scene", to_json(x.scene)},
+  return {{"scene", measured_scene(x, s)},
           {"sweep", {{"warmup", s.warmup}, {"steps", s.steps}, {"repetitions", s.repetitions},
                      {"cell_limit_s", s.cell_limit_s}, {"time", s.time}}}};
 }

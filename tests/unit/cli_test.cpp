@@ -396,7 +396,7 @@ TEST_F(Cli, FailedRunLeavesTheOutputFolderAsItWas) {
 // is named (and measured again by a run); a manifest so is one line too.
 TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   write("x.json", R"({"name": "tiny", "scene": {"model": {"size": [4, 4]}, "drag": null},
-                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2}})");
   const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
   ASSERT_EQ(run(experiment).code, 0);
   const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__4.json";
@@ -450,7 +450,7 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
 // runs, and by --report-only, which writes the report.
 TEST_F(Cli, AFolderInAResultFilesPlaceIsRefusedFirst) {
   write("x.json", R"({"name": "tiny", "scene": {"model": {"size": [4, 4]}, "drag": null},
-                      "sweep": {"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+                      "sweep": {"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2}})");
   const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
   ASSERT_EQ(run(experiment).code, 0);
   const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__5.json";
@@ -476,7 +476,7 @@ TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
   write("x.json", R"({"name": "sheets", "scene": {"model": {"type": "mesh", "pins": "none",
                           "generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.25}}},
       "sweep": {"models": [{"name": "s1", "model": {"generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.2}}}],
-                "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})");
+                "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2}})");
   const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
   ASSERT_EQ(run(experiment).code, 0);
   const fs::path cell = dir_ / "r" / "cells" / "cpu__semi-implicit-euler__s1.json";
@@ -619,7 +619,7 @@ TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
 TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
   if (available_gib() > 50) GTEST_SKIP() << "this host has room for the scene";
   write("x.json", R"({"name": "big-frames", "scene": {"model": {"size": [32768, 32768]}},
-                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2, "frames": 1}})");
+                      "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2, "frames": 1}})");
   const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
   if (r.code == 0 && slurp(dir_ / "r" / "manifest.json").find("OpenGL") != std::string::npos)
     GTEST_SKIP() << "no OpenGL here: no frames are drawn";

@@ -117,28 +117,31 @@ TEST_F(SweepTest, CellsOfAnotherSceneOrMethodAreMeasuredAgain) {
                             "tiny.json");
   };
   const std::string scene = R"({"model": {"size": [4, 4]}})", slow_scene = R"({"model": {"size": [4, 4]}, "dt": 1e-4})";
-  const std::string sweep = R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})";
+  const std::string sweep = R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2})";
   const Experiment x = experiment(scene, sweep);
   const Sweep s = *parse_sweep(x.raw, "tiny");
   auto run = [&](const Experiment& e, SweepOptions o = {}) { return run_sweep(e, *parse_sweep(e.raw, "tiny"), dir_, o, json::array()); };
   ASSERT_EQ(run(x), 2);
   for (const auto& r : load_cells(dir_)) EXPECT_EQ(r["measurement"], cell_measurement(measurement(x, s), s, "")) << r.dump();
   EXPECT_EQ(run(experiment(scene, sweep, R"(, "description": "the same cells")")), 0);
-  EXPECT_EQ(run(experiment(scene, R"({"sizes": [4, 5, 6], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})")), 1);
+  // What the cells do not take (the stop rule, the runaway check, the scene's own size) keeps them.
+  EXPECT_EQ(run(experiment(R"({"model": {"size": [7, 7]}, "threshold": 0.5, "min_steps": 3, "max_steps": 9,
+                               "check_every": 2, "runaway_factor": 3})", sweep)), 0);
+  EXPECT_EQ(run(experiment(scene, R"({"sizes": [4, 5, 6], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2})")), 1);
   int remeasured = 0;
   SweepOptions o;
   o.on_cell = [&](const Cell&, const json&, const SweepProgress& p) { remeasured += p.remeasured; };
   const Experiment slower = experiment(slow_scene, sweep);
   EXPECT_EQ(run(slower, o), 2);
   EXPECT_EQ(remeasured, 2);
-  const Experiment longer = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 3, "repetitions": 2})");
+  const Experiment longer = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 2, "steps": 3, "repetitions": 2})");
   EXPECT_EQ(run(longer), 2);
   EXPECT_EQ(run(longer), 0);
   // A run stopped before it measured a cell again (here by --max-size) leaves that cell out of
   // its report; so does the next run.
   SweepOptions small;
   small.max_size = 4;
-  const Experiment quicker = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})");
+  const Experiment quicker = experiment(slow_scene, R"({"sizes": [4, 5], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2})");
   Sweep up_to_4 = *parse_sweep(quicker.raw, "tiny");
   up_to_4.sizes = {4};  // as `experiment --max-size 4` leaves it
   EXPECT_EQ(run_sweep(quicker, up_to_4, dir_, small, json::array()), 1);
@@ -182,7 +185,7 @@ TEST_F(SweepTest, ARelativeBaseIsReadFromTheExperimentsFolder) {
 // A sweep refuses, before it runs, a folder where it would write over or remove what no
 // experiment wrote.
 TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
-  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2})");
+  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2})");
   const Sweep s = *parse_sweep(x.raw, "tiny");
   auto refusal = [&] {
     try {
@@ -221,7 +224,7 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
   EXPECT_EQ(refusal(), "");
   const Experiment other = parse_experiment(
       R"({"name": "tiny", "base": "paper-drag", "integrator": "midpoint", "scene": {"model": {"size": [4, 4]}, "dt": 1e-4},
-          "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 2, "repetitions": 2}})",
+          "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2}})",
       "tiny.json");
   try {
     require_sweep_folder(dir_, other, s);
@@ -250,7 +253,7 @@ TEST_F(SweepTest, FoldersWithOthersFilesAreRefusedBeforeTheSweep) {
 // Under --max-size the experiment's own grid, if larger, leaves its frames for a later run, as
 // it leaves the sweep's larger sizes; the run without it renders them (or says why it cannot).
 TEST_F(SweepTest, FramesOfAGridOverMaxSizeWaitForALaterRun) {
-  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 1, "steps": 1, "repetitions": 1})");
+  const Experiment x = tiny(R"({"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 1, "repetitions": 1})");
   const Sweep s = *parse_sweep(x.raw, "tiny");
   SweepOptions o;
   o.max_size = 3;
@@ -345,7 +348,7 @@ TEST(Report, CellLabels) {
 TEST_F(SweepTest, LatticeSweepsCountAndLabelTheirSizesCubed) {
   std::ofstream(dir_.string() + "-base.json") << R"({"scene": {"model": {"type": "lattice"}}})";
   const Experiment x = parse_experiment(R"({"name": "cubes", "base": ")" + dir_.string() + R"(-base.json",
-      "sweep": {"sizes": [3, 4], "pipelines": ["cpu"], "warmup": 1, "steps": 1, "repetitions": 1, "frames": 0}})",
+      "sweep": {"sizes": [3, 4], "pipelines": ["cpu"], "warmup": 2, "steps": 1, "repetitions": 1, "frames": 0}})",
                                         "cubes.json");
   fs::remove(dir_.string() + "-base.json");
   const Sweep s = *parse_sweep(x.raw, "cubes.json");
