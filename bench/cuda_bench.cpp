@@ -321,8 +321,15 @@ void add_cuda_bench(CLI::App& app) {
   c->add_option("--steps-per-launch", o->steps_per_launch, "cuda-temporal's steps per launch to compare")
       ->check(deformlab::app::whole_in(1, 8));
   c->add_option("--temporal-tiles", o->temporal_tiles, "cuda-temporal's tiles WxH to compare (default: its own)");
-  c->callback([o] {
+  c->callback([o, c] {
     std::erase(o->temporal_sizes, 0);  // "--temporal-sizes" alone gives {0}
+    // A table's own flags where the table is skipped would do nothing.
+    for (const char* flag : {"--tiles", "--reference-ms"})
+      if (o->tile_size == 0 && c->count(flag) > 0)
+        throw std::invalid_argument(std::string(flag) + ": --tile-size 0 skips the tile sweep and the fused summary");
+    for (const char* flag : {"--steps-per-launch", "--temporal-tiles"})
+      if (o->temporal_sizes.empty() && c->count(flag) > 0)
+        throw std::invalid_argument(std::string(flag) + ": --temporal-sizes none or 0 skips the cuda-temporal table");
     run_cuda(*o);
   });
 }

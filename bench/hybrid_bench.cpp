@@ -144,8 +144,7 @@ void run_hybrid(const HybridOptions& o) {
     }
     for (const auto& u : o.updates)
       for (const auto& mode_name : o.modes) {
-        const auto mode = interop::parse_mode(mode_name);
-        if (!mode) throw std::invalid_argument("unknown interop mode " + mode_name);
+        const auto mode = interop::parse_mode(mode_name);  // checked as the flag was read
         Row r{n, u == "compute" ? "hybrid-compute" : "hybrid", mode_name};
         if (const std::string why = interop::unavailable(*mode); !why.empty()) {
           std::cout << std::setw(6) << n << std::setw(16) << r.pipeline << std::setw(18) << mode_name
@@ -177,12 +176,18 @@ void add_hybrid_bench(CLI::App& app) {
                                          "cuda-fused");
   add_bench_options(*c, *o);
   add_warmup_ms(*c, *o);
-  c->add_option("--modes", o->modes, "Interop modes: map, external, external-gpusync, staged");
-  c->add_option("--updates", o->updates, "Update passes: tf, compute");
+  c->add_option("--modes", o->modes, "Interop modes: " + interop::mode_names())
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return interop::parse_mode(v) ? std::string() : "'" + v + "' is not one of " + interop::mode_names();
+          },
+          ""));
+  c->add_option("--updates", o->updates, "Update passes: tf, compute")->check(CLI::IsMember({"tf", "compute"}));
   c->add_option("--steps", o->steps, "Timed steps at the least (more where they take under 200 ms)")
       ->check(deformlab::app::whole_in(1, std::numeric_limits<int>::max()));
   c->add_flag("!--no-baselines", o->baselines, "Skip the cuda-fused and glsl-tf rows");
-  c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)");
+  c->add_option("--floor-us", o->floor_us, "The hand-off floor, us (default: measured when external-gpusync is swept)")
+      ->check(deformlab::app::real_in(0, 1e6));
   c->callback([o] { run_hybrid(*o); });
 }
 

@@ -597,7 +597,7 @@ TEST_F(Cli, BenchCountsItsPipelinesHostMemory) {
 
 // The bench checks every size and its pipelines' integrator before it prints or times anything:
 // a size past the node limit after one that runs, a size named twice, an integrator a pipeline
-// does not run.
+// does not run, a flag of a table it skips, a name or number a flag does not take.
 TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
   for (const auto& [args, error] :
        {std::pair{"cpu --reps 1 --warmup 0 --sizes 4 100000", "--sizes: size 100000: a model of about 1e+10 nodes exceeds "
@@ -605,7 +605,13 @@ TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 8 4", "--sizes: size 4 is named twice"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv ''", "--csv: an empty file name"},
         std::pair{"gl --reps 1 --warmup 0 --sizes 4 --integrator backward-euler", "glsl-tf: backward-euler needs"},
-        std::pair{"cuda --sizes 64 --graph-sizes 1", "--graph-sizes: size 1: expected 2 or more"}}) {
+        std::pair{"cuda --sizes 64 --graph-sizes 1", "--graph-sizes: size 1: expected 2 or more"},
+        // a table's flags where the table is skipped
+        std::pair{"cuda --tile-size 0 --tiles 8x8", "--tiles: --tile-size 0 skips the tile sweep"},
+        std::pair{"cuda --temporal-sizes 0 --steps-per-launch 2", "--steps-per-launch: --temporal-sizes none or 0 skips"},
+        std::pair{"hybrid --modes telepathy", "--modes: 'telepathy' is not one of map, external, external-gpusync, staged"},
+        std::pair{"hybrid --updates vertex", "--updates: vertex not in {tf,compute}"},
+        std::pair{"hybrid --floor-us nan", "--floor-us: 'nan' is not in 0 to 1000000"}}) {
     const Result r = run(args, DEFORMLAB_BENCH_EXE);
     if (r.err.starts_with("deformlab-bench: error: unknown command '")) continue;  // a build without that backend
     EXPECT_EQ(r.code, 2) << args;
