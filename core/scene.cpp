@@ -455,6 +455,30 @@ Scene load_scene(const std::string& path) {
   return s;
 }
 
+namespace {
+
+// A free node that starts deeper in the ground or a sphere than a step may move it (runaway_factor
+// x extent) is pushed out by more at the first step, which a run takes for divergence: refused.
+void require_start_outside_colliders(const Model& m, const Params& p) {
+  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+  for (int i = 0; i < m.node_count(); ++i) {
+    if (m.pinned(i) || (p.drag.active() && !p.drag.as_spring && i == p.drag.node)) continue;
+    const Vec3f x = m.rest_position[i];
+    std::string where;
+    double depth = 0;
+    if (p.ground && double(*p.ground) - x.y > bound) depth = double(*p.ground) - x.y, where = "below the ground";
+    for (std::size_t k = 0; k < p.spheres.size() && where.empty(); ++k)
+      if (const double d = double(p.spheres[k].radius) - norm(x - p.spheres[k].center); d > bound)
+        depth = d, where = "inside spheres[" + std::to_string(k) + "]";
+    if (!where.empty())
+      throw std::invalid_argument("node " + std::to_string(m.file_index(i)) + " starts " + significant_trimmed(depth, 3) +
+                                  " m " + where + ", deeper than a step may move a node (runaway_factor x model extent: " +
+                                  significant_trimmed(bound, 3) + " m); its first step would be taken for divergence");
+  }
+}
+
+}  // namespace
+
 Params resolve_params(const Scene& s, const Model& m) {
   Params p = s.params;
   if (s.drag.enabled) {
@@ -475,6 +499,7 @@ Params resolve_params(const Scene& s, const Model& m) {
     p.drag = {};
   }
   validate(p, m.node_count());
+  require_start_outside_colliders(m, p);
   // The handle takes its node where it rests at t = 0: a path whose first key comes later
   // starts with the way from there to that key, not with a jump onto it. (After the checks,
   // whose messages count the scene's own keyframes.)

@@ -180,6 +180,12 @@ const std::vector<BadInput>& cases() {
       scene("drag_stiffness", "{\"drag\": {\"stiffness\": -5}}", "s.json.drag.stiffness: expected a number > 0"),
       scene("drag_stiffness_hard", "{\"drag\": {\"mode\": \"hard\", \"stiffness\": 5}}",
             "s.json.drag.stiffness: the spring mode's (\"mode\": \"spring\"); the hard mode puts the node on its path"),
+      scene("start_deep_in_the_ground", "{\"model\": {\"size\": [4, 4], \"height\": -3}, \"ground\": 0}",
+            "node 1 starts 3 m below the ground, deeper than a step may move a node (runaway_factor x model extent: "
+            "1.41 m); its first step would be taken for divergence"),
+      scene("start_deep_in_a_sphere",
+            "{\"model\": {\"size\": [4, 4], \"width\": 0.2}, \"spheres\": [{\"center\": [0, 1, 0], \"radius\": 3}]}",
+            "inside spheres[0], deeper than a step may move a node"),
       scene("drag_path_empty", "{\"drag\": {\"path\": []}}", "s.json.drag.path: expected a non-empty list"),
       scene("drag_keyframe_short", "{\"drag\": {\"path\": [[0, 0, 0]]}}", "s.json.drag.path[0]: expected [t, x, y, z]"),
       scene("drag_keyframes_backwards", "{\"drag\": {\"path\": [[1, 0, 0, 0], [0.5, 0, 0, 0]]}}",
