@@ -1,4 +1,3 @@
-#include <algorithm>
 #include "pipelines.hpp"
 
 #include <stdexcept>
@@ -124,7 +123,7 @@ Options options_of(Variant v, const PipelineOptions& o) {
 std::string idle_option(Variant v, const PipelineOptions& o, Topology t) {
   if (v == Variant::temporal && t == Topology::general) return {};  // it runs no mesh, which it says
   if (const auto it = o.find("tile"); it != o.end()) {
-    if (v == Variant::temporal && t == Topology::cloth_grid && std::count(it->second.begin(), it->second.end(), 'x') == 2)
+    if (v == Variant::temporal && t == Topology::cloth_grid && parse_temporal_tile(it->second).z > 0)
       return "option tile '" + it->second + "': a cloth's tile is WxH nodes (WxHxD is a lattice's)";
     if (v != Variant::tiled && t == Topology::general)
       return "option tile: on a mesh this pipeline runs one thread per node in blocks of its own (of the CUDA "

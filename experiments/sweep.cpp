@@ -51,6 +51,12 @@ namespace {
   throw std::invalid_argument(where + ": " + what);
 }
 
+// Whether `pipeline` reads the option `name`.
+bool reads(const std::string& pipeline, const std::string& name) {
+  const auto& names = pipelines().find(pipeline)->options;
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
 std::vector<std::string> strings(const json& j, const std::string& where) {
   if (!j.is_array() || j.empty()) bad(where, "expected a non-empty list of names");
   std::vector<std::string> out;
@@ -162,20 +168,15 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   check_models_under_orders(s, w);
   for (const auto& o : s.option_sets)
     for (const auto& [name, value] : o) {
-      const bool read = std::any_of(s.pipelines.begin(), s.pipelines.end(), [&, &name = name](const std::string& p) {
-        const auto& names = pipelines().find(p)->options;
-        return std::find(names.begin(), names.end(), name) != names.end();
-      });
-      if (!read) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
+      if (std::none_of(s.pipelines.begin(), s.pipelines.end(), [&name](const std::string& p) { return reads(p, name); })) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
     }
   // A pipeline runs a set whose every option it reads (cells): one that reads some of a set
   // would run without it.
   for (std::size_t k = 0; k < s.option_sets.size(); ++k)
     for (const auto& p : s.pipelines) {
-      const auto& names = pipelines().find(p)->options;
       std::string read, unread;
       for (const auto& [name, value] : s.option_sets[k]) {
-        std::string& list = std::find(names.begin(), names.end(), name) != names.end() ? read : unread;
+        std::string& list = reads(p, name) ? read : unread;
         list += (list.empty() ? "" : ", ") + name;
       }
       if (!read.empty() && !unread.empty())
@@ -207,13 +208,9 @@ std::vector<Cell> cells(const Sweep& s) {
       for (const auto& pipe : s.pipelines) {
         // A pipeline runs the option sets whose every name it reads (the empty set among them);
         // with none, it runs once, with its defaults.
-        const auto& accepted = pipelines().find(pipe)->options;
         std::vector<PipelineOptions> sets;
         for (const auto& o : s.option_sets)
-          if (std::all_of(o.begin(), o.end(), [&](const auto& kv) {
-                return std::find(accepted.begin(), accepted.end(), kv.first) != accepted.end();
-              }))
-            sets.push_back(o);
+          if (std::all_of(o.begin(), o.end(), [&](const auto& kv) { return reads(pipe, kv.first); })) sets.push_back(o);
         if (sets.empty()) sets.push_back({});
         for (const auto& o : sets) out.push_back({model.size, pipe, integ, o, model.model, model.order});
       }
