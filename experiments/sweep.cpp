@@ -167,8 +167,10 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   }
   check_models_under_orders(s, w);
   for (const auto& o : s.option_sets)
-    for (const auto& [name, value] : o) {
-      if (std::none_of(s.pipelines.begin(), s.pipelines.end(), [&name](const std::string& p) { return reads(p, name); })) bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
+    for (const auto& entry : o) {
+      const std::string& name = entry.first;
+      if (std::none_of(s.pipelines.begin(), s.pipelines.end(), [&name](const std::string& p) { return reads(p, name); }))
+        bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
     }
   // A pipeline runs a set whose every option it reads (cells): one that reads some of a set
   // would run without it.
