@@ -131,10 +131,16 @@ void check_run_flags(const RunArgs& a) {
 namespace {
 
 // Refuses a run whose host memory does not fit before anything is allocated.
+// With no pipeline chosen yet (`best` in `view`, before its window), a model that no pipeline
+// holds.
 void check_fits(const RunInput& in, bool compare, const ModelSize& size) {
-  const std::string why = host_memory_shortfall(size, *in.entry, in.integ, in.options,
-                                                compare ? pipelines().find("reference") : nullptr);
-  if (!why.empty()) throw BadInput(why);
+  std::string why;
+  for (const PipelineEntry& e : pipelines().all()) {
+    if (in.entry && in.entry != &e) continue;
+    why = host_memory_shortfall(size, e, in.integ, in.options, compare ? pipelines().find("reference") : nullptr);
+    if (why.empty()) return;
+  }
+  throw BadInput(why);
 }
 
 // A run keeps a record of each step until it ends (timings.csv, the spans of sampled steps):
@@ -245,16 +251,25 @@ std::string stop_rule_start(const Params& p) {
                                                   : "the stop rule starts at step " + std::to_string(step) + why;
 }
 
-void check_run_names(const RunArgs& a) {
-  const Experiment x = read_experiment(a);
-  const Integrator integ = integrator_of(x);
-  if (x.pipeline != "best") parse_options(a.options, *find_pipeline(x, integ));
+namespace {
+
+// The checks that need the pipeline's entry, once it is known.
+void check_pipeline(const RunArgs& a, RunInput& in) {
+  try {
+    check_options(*in.entry, in.options, in.x.scene.model.topology);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(e.what());
+  }
+  if (a.compare && in.entry->name == "reference")
+    throw BadInput("--compare reference: the pipeline run is 'reference' itself");
 }
 
-RunInput read_run_input(const RunArgs& a, Output output) {
+// read_run_input, or for `view` read_run_model: no output folder, and the pipeline left for
+// resolve_pipeline where choosing it needs a GL context (`best`), its availability too.
+RunInput read(const RunArgs& a, bool view) {
   RunInput in;
   in.x = read_experiment(a);
-  if (output == Output::folder) {
+  if (!view) {
     const std::string name = in.x.name.empty() ? std::string("run") : in.x.name;
     in.out = a.out ? *a.out : "runs/" + name + (in.x.raw.contains("sweep") ? "-run" : "");
     require_folder_or_nothing(in.out);
@@ -262,29 +277,25 @@ RunInput read_run_input(const RunArgs& a, Output output) {
     require_writable(in.out);
   }
   in.integ = integrator_of(in.x);
-  in.entry = find_pipeline(in.x, in.integ);
-  in.options = parse_options(a.options, *in.entry);
-  require_runs(in.entry, in.x, in.integ);
-  if (a.gl_device && output == Output::folder && !a.frames && !is_gl(in.entry->traits.force) &&
+  if (!view || in.x.pipeline != "best") {
+    in.entry = find_pipeline(in.x, in.integ);
+    in.options = parse_options(a.options, *in.entry);
+  }
+  if (!view) require_runs(in.entry, in.x, in.integ);
+  if (a.gl_device && !view && !a.frames && !is_gl(in.entry->traits.force) &&
       !is_gl(in.entry->traits.update))
     throw BadInput("--gl-device: pipeline '" + in.entry->name + "' runs no OpenGL pass, and no --frames are drawn");
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
-  try {
-    check_options(*in.entry, in.options, in.x.scene.model.topology);
-  } catch (const std::invalid_argument& e) {
-    throw BadInput(e.what());
-  }
+  if (a.compare && *a.compare != "reference")
+    throw BadInput("--compare '" + *a.compare +
+                   "': the only pipeline to compare with is 'reference' (double precision)");
+  if (in.entry) check_pipeline(a, in);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   if (a.threshold && !in.until_converged)
     throw BadInput("--threshold applies to a run until converged (--until-converged); this one takes a fixed number "
                    "of steps");
   check_records_fit(in.x.scene.params);
-  if (a.compare && *a.compare != "reference")
-    throw BadInput("--compare '" + *a.compare +
-                   "': the only pipeline to compare with is 'reference' (double precision)");
-  if (a.compare && in.entry->name == "reference")
-    throw BadInput("--compare reference: the pipeline run is 'reference' itself");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
@@ -296,8 +307,24 @@ RunInput read_run_input(const RunArgs& a, Output output) {
   if (in.until_converged && a.steps && first_stop_step(in.params) > in.params.max_steps)
     throw BadInput("--steps " + std::to_string(in.params.max_steps) + " with --until-converged: " +
                    stop_rule_start(in.params) + ", so give at least that many steps");
-  if (output == Output::folder) check_disk_fits(a, in);
+  if (!view) check_disk_fits(a, in);
   return in;
+}
+
+}  // namespace
+
+RunInput read_run_input(const RunArgs& a) { return read(a, false); }
+
+RunInput read_run_model(const RunArgs& a) { return read(a, true); }
+
+void resolve_pipeline(const RunArgs& a, RunInput& in) {
+  if (!in.entry) {
+    in.entry = find_pipeline(in.x, in.integ);
+    in.options = parse_options(a.options, *in.entry);
+    check_pipeline(a, in);
+    check_fits(in, bool(a.compare), in.model.size());
+  }
+  require_runs(in.entry, in.x, in.integ);
 }
 
 }  // namespace deformlab::app

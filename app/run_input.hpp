@@ -36,13 +36,14 @@ void check_run_flags(const RunArgs& a);
 // the kernel's own file systems (proc, sysfs, ...), which hold no files of ours, or where this
 // process may not write (the nearest folder above it that exists, where it does not).
 void require_writable(const std::filesystem::path& out);
-// `run`'s output folder is checked first, before the model is built; `view` writes none.
-enum class Output { folder, none };
-RunInput read_run_input(const RunArgs& a, Output output = Output::folder);
-// The checks of read_run_input that need no GPU: the experiment and scene files, the integrator,
-// a named pipeline and its options, refused as read_run_input refuses them. `view` makes them
-// before it opens its window, so that bad input is named on a machine without a display too.
-void check_run_names(const RunArgs& a);
+// `run`'s output folder is checked first, before the model is built.
+RunInput read_run_input(const RunArgs& a);
+// `view`'s two halves of read_run_input, which writes no folder, the first before its window opens, so that
+// bad input is named on a machine without a display too: read_run_model makes every check and
+// builds the model, but leaves the pipeline unchosen where choosing it needs a GL context (`best`)
+// and does not ask whether it runs here; resolve_pipeline, in the window's context, does both.
+RunInput read_run_model(const RunArgs& a);
+void resolve_pipeline(const RunArgs& a, RunInput& in);
 // When a convergence run's stop rule starts (first_stop_step), in words.
 std::string stop_rule_start(const Params& p);
 

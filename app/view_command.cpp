@@ -39,7 +39,6 @@ int view_command(const ViewArgs& a) {
     if (a.record && std::filesystem::path(*a.record).extension() != ".mp4")
       throw std::invalid_argument("--record '" + *a.record + "': expected a file name ending in .mp4 (the recording is "
                                   "H.264 in an MP4 file)");
-    check_run_names(a.run);
 #if DEFORMLAB_HAVE_VIEWER
     viewer::ViewOptions o;
     o.steps_per_frame = a.steps_per_frame;
@@ -54,8 +53,9 @@ int view_command(const ViewArgs& a) {
     o.seconds = a.seconds.value_or(0.0);
     o.frames = a.max_frames.value_or(0);
     o.summary = a.summary.value_or("");
+    RunInput in = read_run_model(a.run);
     viewer::Window w(size[0] + viewer::kPanelWidth, size[1], "deformlab view");
-    RunInput in = read_run_input(a.run, Output::none);
+    resolve_pipeline(a.run, in);
     w.set_title("deformlab view: " + describe(in.x.scene.model));
     viewer::Session s({std::move(in.model), in.params, in.entry, in.integ, in.options});
     return viewer::run(w, s, o);
