@@ -55,7 +55,10 @@ int experiment_command(const ExperimentArgs& a) {
     return 2;
   }
   return report_errors([&] {
-    if (!a.report_only) require_model_files(x, *sweep, a.file);  // builds the models: out of memory is bad input
+    if (!a.report_only) {  // builds the models: out of memory is bad input
+      require_model_files(x, *sweep, a.file);
+      require_size_scenes(x, *sweep, a.file);
+    }
     if (a.report_only && !calibration.is_null()) {
       // Records the calibration given in the folder's manifest; the cells stay as they are.
       nlohmann::json manifest = read_manifest(dir);

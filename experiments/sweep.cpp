@@ -219,6 +219,24 @@ std::vector<Cell> cells(const Sweep& s) {
   return out;
 }
 
+void size_model(ModelSpec& ms, int n) {
+  ms.nx = ms.ny = n;
+  ms.nz = ms.topology == Topology::lattice ? n : 1;
+}
+
+void require_size_scenes(const Experiment& x, const Sweep& s, const std::string& where) {
+  for (std::size_t k = 0; k < s.sizes.size(); ++k) {
+    Scene scene = x.scene;
+    size_model(scene.model, s.sizes[k]);
+    if (model_size(scene.model).nodes > kCheckedNodes) continue;
+    try {
+      resolve_params(scene, build_model(scene));
+    } catch (const std::invalid_argument& e) {
+      bad(where + ".sweep.sizes[" + std::to_string(k) + "]", "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
+    }
+  }
+}
+
 // Why the experiment's own scene, of `size`, whose frames the sweep draws on the best pipeline
 // for its integrator, does not fit this host's memory, else "".
 std::string frames_shortfall(const Experiment& x, const ModelSize& size) {

@@ -58,7 +58,15 @@ struct Cell {
 // Grid size n as a label: "n²" for a cloth, "n³" for a lattice.
 std::string size_label(int n, bool lattice);
 
+// Sizes `ms`, a grid or lattice, to the cell size n (n x n, or n^3).
+void size_model(ModelSpec& ms, int n);
+
 std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::string& where);
+// Throws std::invalid_argument naming the first grid size on which the experiment's scene is bad
+// input (a pin or drag node outside or on each other, a node deep in a collider: resolve_params),
+// checked before the first cell on every size of up to kCheckedNodes nodes (built for it).
+constexpr std::int64_t kCheckedNodes = std::int64_t(1) << 22;
+void require_size_scenes(const Experiment& x, const Sweep& s, const std::string& where);
 std::vector<Cell> cells(const Sweep& s);
 
 struct SweepProgress {

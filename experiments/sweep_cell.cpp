@@ -35,10 +35,8 @@ json not_applicable(json r, const std::string& why) {
 // Sizes the scene's grid to the cell and records its nodes and springs in `r`; returns why it
 // does not fit here, else "".
 std::string size_grid(Scene& scene, const Cell& c, const PipelineEntry& e, Integrator i, json& r) {
-  ModelSpec& ms = scene.model;
-  ms.nx = ms.ny = c.size;
-  ms.nz = ms.topology == Topology::lattice ? c.size : 1;
-  const ModelSize size = model_size(ms);
+  size_model(scene.model, c.size);
+  const ModelSize size = model_size(scene.model);
   r["nodes"] = size.nodes;
   r["springs"] = size.springs;
   const std::string why = host_memory_shortfall(size, e, i, c.options);
