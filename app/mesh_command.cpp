@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "core/number_text.hpp"
+#include "experiments/output.hpp"
 #include "experiments/sweep_models.hpp"
 #include "mesh/scene_model.hpp"
 
@@ -45,7 +46,8 @@ int mesh_command(const MeshArgs& a) {
     namespace fs = std::filesystem;
     if (fs::path(a.out).extension() != ".msh")
       throw std::invalid_argument("--out '" + a.out + "': expected a file name ending in .msh");
-    if (fs::is_directory(a.out)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
+    require_name_lengths(a.out, "--out");
+    if (std::error_code ec; fs::is_directory(a.out, ec)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
     const Scene scene = chosen_scene(a);
     const MeshSpec& ms = scene.model.mesh;
     if (!makes_mesh(scene.model))

@@ -16,7 +16,7 @@ namespace deformlab {
 using nlohmann::json;
 
 bool is_plain_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." && std::all_of(name.begin(), name.end(), [](char ch) {
+  return !name.empty() && name.size() <= kPlainNameMax && name != "." && name != ".." && std::all_of(name.begin(), name.end(), [](char ch) {
     return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.';
   });
 }

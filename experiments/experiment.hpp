@@ -21,7 +21,10 @@ struct Experiment {
 // Whether `name` may name an experiment or a sweep's model, and so a folder or file: letters,
 // digits, '-', '_' and '.', not empty, not "." or "..".
 bool is_plain_name(const std::string& name);
-constexpr const char* kPlainName = "expected a name of letters, digits, '-', '_' and '.'";
+// At most 64 bytes: a cell's file name joins a model's name to its pipeline, integrator and
+// options, and a file name takes 255.
+constexpr std::size_t kPlainNameMax = 64;
+constexpr const char* kPlainName = "expected a name of up to 64 letters, digits, '-', '_' and '.'";
 
 // Parses experiment JSON text; `where` names it in errors (file name or "built-in ...");
 // relative mesh files are taken from `dir`.

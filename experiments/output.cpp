@@ -4,6 +4,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <linux/limits.h>
+
 #include <algorithm>
 #include <cerrno>
 
@@ -25,7 +27,20 @@ namespace deformlab {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+void require_name_lengths(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  const std::string full = fs::absolute(path, ec).string();
+  if (full.size() >= PATH_MAX)
+    throw std::invalid_argument(what + " '" + path.string() + "': a path of " + std::to_string(full.size()) +
+                                " bytes, longer than a path may be (" + std::to_string(PATH_MAX - 1) + ")");
+  for (const auto& part : path)
+    if (part.string().size() > NAME_MAX)
+      throw std::invalid_argument(what + " '" + path.string() + "': a name of " + std::to_string(part.string().size()) +
+                                  " bytes, longer than a file name may be (" + std::to_string(NAME_MAX) + ")");
+}
+
 void require_folder_or_nothing(const fs::path& dir) {
+  require_name_lengths(dir, "output folder");
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
@@ -90,6 +105,7 @@ fs::path temporary(const fs::path& name) { return name.string().append(kTemporar
 void require_file_target(const std::string& file, const std::string& what) {
   std::error_code ec;
   if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
+  require_name_lengths(file, what);
   const fs::path folder = fs::path(file).parent_path();
   if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
   if (!folder.empty() && !fs::is_directory(folder, ec))

@@ -18,7 +18,10 @@
 
 namespace deformlab {
 
-// Throws std::invalid_argument when `dir` exists and is not a folder.
+// Throws std::invalid_argument, naming `what`, where `path` holds a name longer than a file
+// name may be (NAME_MAX, 255 bytes) or is itself longer than a path may be (PATH_MAX).
+void require_name_lengths(const std::filesystem::path& path, const std::string& what);
+// Throws std::invalid_argument when `dir` exists and is not a folder, or its name is too long.
 void require_folder_or_nothing(const std::filesystem::path& dir);
 
 // `dir`/manifest.json, or null when there is none or it is not JSON.
@@ -40,7 +43,7 @@ void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 std::string foreign_frames_entry(const std::filesystem::path& frames);
 
 // Throws std::invalid_argument where `file`, named by `what` (a flag), could not be written: an
-// empty name, a folder in its place, or no folder to hold it.
+// empty name, a name too long, a folder in its place, or no folder to hold it.
 void require_file_target(const std::string& file, const std::string& what);
 // The temporary name of `name` for this process: "<name>.deformlab-tmp-<pid>". The names of
 // temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other

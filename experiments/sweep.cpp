@@ -186,14 +186,20 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
             p + " reads " + read + " but not " + unread + ", so it would run without this set (a pipeline runs the "
             "sets whose every option it reads: give it a set of its own)");
     }
-  // Each cell's options as its model reads them: the sweep's grids (its scene's topology) or meshes.
-  for (const Cell& c : cells(s))
+  // Each cell's options as its model reads them: the sweep's grids (its scene's topology) or meshes;
+  // its id short enough for a file name with room for its temporary's (output.hpp).
+  constexpr std::size_t kMaxId = 200;
+  for (const Cell& c : cells(s)) {
+    if (c.id().size() > kMaxId)
+      bad(w, "cell '" + c.id() + "' takes a file name of " + std::to_string(c.id().size()) + " bytes, more than " +
+                 std::to_string(kMaxId) + ": shorten its model's name or its options' values");
     try {
       check_options(*pipelines().find(c.pipeline), c.options,
                     !c.model.empty() ? Topology::general : s.lattice ? Topology::lattice : Topology::cloth_grid);
     } catch (const std::invalid_argument& e) {
       bad(w + ".options", e.what());
     }
+  }
   return s;
 }
 

@@ -100,6 +100,20 @@ const std::vector<BadInput>& cases() {
       {"option_twice", "run --pipeline cpu --option tile=8x8 --option tile=4x4", "option 'tile' is given twice"},
       {"gl_device_negative", "run --gl-device -1", "--gl-device: '-1' is not in 0 to 1023"},
       {"unknown_flag", "run --colour red", "--colour"},
+      {"out_name_too_long", "run --grid 4x4 --steps 2 --out {dir}/" + std::string(300, 'q'),
+       "a name of 300 bytes, longer than a file name may be (255)"},
+      {"experiment_out_name_too_long", "experiment quick --out {dir}/" + std::string(300, 'q'),
+       "a name of 300 bytes, longer than a file name may be (255)"},
+      {"mesh_out_name_too_long", "mesh --experiment meshes --model bunny-shell --out {dir}/" + std::string(300, 'q') + ".msh",
+       ".msh': a name of 304 bytes, longer than a file name may be (255)"},
+      {"experiment_name_too_long", "experiment {dir}/x.json",
+       "x.json.name: expected a name of up to 64 letters, digits, '-', '_' and '.'",
+       {{"x.json", R"({"name": ")" + std::string(65, 'n') + R"(", "base": "quick"})"}}},
+      {"sweep_cell_name_too_long", "experiment {dir}/x.json",
+       "x.json.sweep: cell 'glsl-compute__semi-implicit-euler__8__window-" + std::string(200, '0') +
+           "64' takes a file name of 247 bytes, more than 200",
+       {{"x.json", R"({"base": "quick", "sweep": {"sizes": [8], "pipelines": ["glsl-compute"], "options": [{"window": ")" +
+                       std::string(200, '0') + R"(64"}]}})"}}},
       {"grid_too_large", "run --grid 100000x100000", "exceeds the limit of 2^30 nodes"},
       {"lattice_too_large", "run --lattice 2000x2000x2000", "exceeds the limit of 2^30 nodes"},
       // 2^22 x 2^21 x 2^21 nodes: 2^64, 0 in 64 bits
