@@ -10,6 +10,7 @@
 #include "core/json_file.hpp"
 
 #include "experiment_files.hpp"
+#include "pipelines.hpp"
 
 namespace deformlab {
 
@@ -63,7 +64,12 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       x.name = str();
       if (!is_plain_name(x.name)) throw std::invalid_argument(where + ".name: " + kPlainName);
     } else if (k == "description") x.description = str();
-    else if (k == "pipeline") x.pipeline = str();
+    else if (k == "pipeline") {
+      x.pipeline = str();
+      if (x.pipeline != "best" && !pipelines().find(x.pipeline))  // also where a sweep names its own, as above
+        throw std::invalid_argument(where + ".pipeline: unknown pipeline '" + x.pipeline + "' (valid: best, " +
+                                    pipelines().names() + ")");
+    }
     else if (k == "integrator") {
       x.integrator = str();
       if (!parse_integrator(x.integrator))  // also where a sweep names its own: a frame or a run takes this one

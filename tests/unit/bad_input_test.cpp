@@ -48,6 +48,8 @@ const std::vector<BadInput>& cases() {
   static const std::vector<BadInput> all = {
       // flags
       {"unknown_pipeline", "run --pipeline warp", "unknown pipeline 'warp' (valid: best, "},
+      {"experiment_unknown_pipeline", "experiment {dir}/x.json", "x.json.pipeline: unknown pipeline 'warp' (valid: best, ",
+       {{"x.json", R"({"base": "quick", "pipeline": "warp"})"}}},
       {"unknown_integrator", "run --integrator leapfrog", "unknown integrator 'leapfrog' (valid: explicit-euler, "},
       {"grid_zero", "run --grid 0x5", "--grid '0x5'"},
       {"grid_negative", "run --grid -3x4", "--grid"},
