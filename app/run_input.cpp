@@ -62,25 +62,37 @@ const PipelineEntry* find_pipeline(const Experiment& x, Integrator integ) {
   return entry;
 }
 
-// Throws unless `entry` is available here and runs `integ`.
-void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator integ) {
-  if (const auto why = entry->unavailable(); !why.empty())
-    throw BadInput("pipeline '" + entry->name + "' is not available: " + why);
+// Throws unless `entry` runs `integ`.
+void require_supports(const PipelineEntry* entry, const Experiment& x, Integrator integ) {
   if (const auto why = entry->unsupported(integ); !why.empty())
     throw BadInput("integrator '" + x.integrator + "' is not available on " + entry->name + ": " + why);
 }
 
-// --option NAME=VALUE flags, each an option the pipeline reads, with a value it can read.
-PipelineOptions parse_options(const std::vector<std::string>& flags, const PipelineEntry& entry) {
+// Throws unless `entry` is available here and runs `integ`.
+void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator integ) {
+  if (const auto why = entry->unavailable(); !why.empty())
+    throw BadInput("pipeline '" + entry->name + "' is not available: " + why);
+  require_supports(entry, x, integ);
+}
+
+// --option NAME=VALUE flags, each an option the pipeline reads, with a value it can read; with no
+// pipeline chosen yet (`view`'s best, before its window), each an option some pipeline reads.
+PipelineOptions parse_options(const std::vector<std::string>& flags, const PipelineEntry* entry) {
   PipelineOptions options;
   for (const auto& o : flags) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0) throw BadInput("--option '" + o + "': expected NAME=VALUE");
-    if (!options.emplace(o.substr(0, eq), o.substr(eq + 1)).second)
-      throw BadInput("--option '" + o + "': option '" + o.substr(0, eq) + "' is given twice");
+    const std::string name = o.substr(0, eq);
+    if (!options.emplace(name, o.substr(eq + 1)).second)
+      throw BadInput("--option '" + o + "': option '" + name + "' is given twice");
+    const auto& all = pipelines().all();
+    if (!entry && std::none_of(all.begin(), all.end(), [&](const PipelineEntry& e) {
+          return std::find(e.options.begin(), e.options.end(), name) != e.options.end();
+        }))
+      throw BadInput("--option '" + o + "': no pipeline has an option '" + name + "'");
   }
   try {
-    check_options(entry, options);
+    if (entry) check_options(*entry, options);
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }
@@ -131,16 +143,12 @@ void check_run_flags(const RunArgs& a) {
 namespace {
 
 // Refuses a run whose host memory does not fit before anything is allocated.
-// With no pipeline chosen yet (`best` in `view`, before its window), a model that no pipeline
-// holds.
+// With no pipeline chosen yet (`best` in `view`, before its window), the model and its state.
 void check_fits(const RunInput& in, bool compare, const ModelSize& size) {
-  std::string why;
-  for (const PipelineEntry& e : pipelines().all()) {
-    if (in.entry && in.entry != &e) continue;
-    why = host_memory_shortfall(size, e, in.integ, in.options, compare ? pipelines().find("reference") : nullptr);
-    if (why.empty()) return;
-  }
-  throw BadInput(why);
+  const PipelineEntry* reference = compare ? pipelines().find("reference") : nullptr;
+  const std::string why = in.entry ? host_memory_shortfall(size, *in.entry, in.integ, in.options, reference)
+                                   : model_memory_shortfall(size, in.integ, reference);
+  if (!why.empty()) throw BadInput(why);
 }
 
 // A run keeps a record of each step until it ends (timings.csv, the spans of sampled steps):
@@ -265,7 +273,7 @@ void check_pipeline(const RunArgs& a, RunInput& in) {
 }
 
 // read_run_input, or for `view` read_run_model: no output folder, and the pipeline left for
-// resolve_pipeline where choosing it needs a GL context (`best`), its availability too.
+// resolve_pipeline where choosing it needs a GL context (`best`), and a GL pipeline's availability.
 RunInput read(const RunArgs& a, bool view) {
   RunInput in;
   in.x = read_experiment(a);
@@ -277,11 +285,13 @@ RunInput read(const RunArgs& a, bool view) {
     require_writable(in.out);
   }
   in.integ = integrator_of(in.x);
-  if (!view || in.x.pipeline != "best") {
-    in.entry = find_pipeline(in.x, in.integ);
-    in.options = parse_options(a.options, *in.entry);
-  }
-  if (!view) require_runs(in.entry, in.x, in.integ);
+  if (!view || in.x.pipeline != "best") in.entry = find_pipeline(in.x, in.integ);
+  in.options = parse_options(a.options, in.entry);
+  // Whether a GL pipeline is available waits, in `view`, for its window's context.
+  if (in.entry && (!view || !(is_gl(in.entry->traits.force) || is_gl(in.entry->traits.update))))
+    require_runs(in.entry, in.x, in.integ);
+  else if (in.entry)
+    require_supports(in.entry, in.x, in.integ);
   if (a.gl_device && !view && !a.frames && !is_gl(in.entry->traits.force) &&
       !is_gl(in.entry->traits.update))
     throw BadInput("--gl-device: pipeline '" + in.entry->name + "' runs no OpenGL pass, and no --frames are drawn");
@@ -320,7 +330,7 @@ RunInput read_run_model(const RunArgs& a) { return read(a, true); }
 void resolve_pipeline(const RunArgs& a, RunInput& in) {
   if (!in.entry) {
     in.entry = find_pipeline(in.x, in.integ);
-    in.options = parse_options(a.options, *in.entry);
+    in.options = parse_options(a.options, in.entry);
     check_pipeline(a, in);
     check_fits(in, bool(a.compare), in.model.size());
   }

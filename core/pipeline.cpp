@@ -96,12 +96,15 @@ std::string PipelineRegistry::names() const {
   return s;
 }
 
-std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
-                                  const PipelineOptions& o, const PipelineEntry* reference) {
+namespace {
+
+// host_memory_shortfall; with no `e`, the model and its state alone.
+std::string shortfall(const ModelSize& m, const PipelineEntry* e, Integrator i, const PipelineOptions& o,
+                      const PipelineEntry* reference) {
   constexpr std::int64_t kMaxNodes = std::int64_t(1) << 30;
-  auto own = [&](const PipelineEntry& p) { return p.footprint ? p.footprint(m, i, o).host : 0; };
+  auto own = [&](const PipelineEntry* p) { return p && p->footprint ? p->footprint(m, i, o).host : 0; };
   const std::int64_t model = model_host_bytes(m), state = state_host_bytes(m.nodes), pipe = own(e);
-  const std::int64_t ref = reference ? own(*reference) + state : 0;
+  const std::int64_t ref = reference ? own(reference) + state : 0;
   const std::int64_t need = model + pipe + state + ref;
   const auto limit = host_memory_limit();
   if (m.nodes <= kMaxNodes && (!limit || need <= limit->bytes)) return {};
@@ -111,11 +114,24 @@ std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, In
     os << " exceeds the limit of 2^30 nodes";
     return os.str();
   }
-  os << " on " << e.name << " needs " << gib(need) << " of host memory (model " << gib(model) << ", pipeline "
-     << gib(pipe) << ", state " << gib(state);
+  if (e) os << " on " << e->name;
+  os << " needs " << (e ? "" : "at least ") << gib(need) << " of host memory (model " << gib(model);
+  if (e) os << ", pipeline " << gib(pipe);
+  os << ", state " << gib(state);
   if (reference) os << ", " << reference->name << " pipeline and state " << gib(ref);
   os << "); " << limit->name << " leaves " << gib(limit->bytes);
   return os.str();
+}
+
+}  // namespace
+
+std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
+                                  const PipelineOptions& o, const PipelineEntry* reference) {
+  return shortfall(m, &e, i, o, reference);
+}
+
+std::string model_memory_shortfall(const ModelSize& m, Integrator i, const PipelineEntry* reference) {
+  return shortfall(m, nullptr, i, {}, reference);
 }
 
 }  // namespace deformlab

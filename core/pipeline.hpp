@@ -161,6 +161,8 @@ void check_options(const PipelineEntry& e, const PipelineOptions& o, Topology t)
 // limit that refuses it. The device's share is checked when the pipeline is built.
 std::string host_memory_shortfall(const ModelSize& m, const PipelineEntry& e, Integrator i,
                                   const PipelineOptions& o, const PipelineEntry* reference = nullptr);
+// The same before a pipeline is chosen (`deformlab view`'s `best`): the model and its state alone.
+std::string model_memory_shortfall(const ModelSize& m, Integrator i, const PipelineEntry* reference = nullptr);
 
 // Runs `steps` steps of `p`, each timed by `t` (one of p's timers, with nothing pending);
 // their ms in order.

@@ -294,6 +294,13 @@ TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {
   // 6 vec3 of doubles and a state, 180 GiB at 2^30 nodes.
   const std::string both = host_memory_shortfall(big, cpu, Integrator::semi_implicit_euler, {}, &ref);
   EXPECT_NE(both.find("reference pipeline and state 180 GiB"), std::string::npos) << both;
+  // Before a pipeline is chosen (`view`'s best): the model and its state alone, 52 GiB.
+  const std::string model = model_memory_shortfall(big, Integrator::semi_implicit_euler);
+  if (model_host_bytes(big) + state_host_bytes(big.nodes) > limit->bytes)
+    EXPECT_EQ(model, "a model of 1073741824 nodes needs at least 52 GiB of host memory (model 16 GiB, state 36 GiB); " +
+                         limit->name + " leaves " + gib(limit->bytes));
+  else
+    EXPECT_EQ(model, "");
 }
 
 }  // namespace
