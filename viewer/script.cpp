@@ -3,7 +3,9 @@
 #include <cfloat>
 #include <climits>
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -75,9 +77,11 @@ Event from_json(const nlohmann::json& j) {
       e.shift = v.get<bool>();
     } else if (key == "key") {
       e.key = text(v, key);
-      const bool letter = e.key.size() == 1 && e.key[0] >= 'a' && e.key[0] <= 'z';
-      if (!letter && e.key != "space" && e.key != "backspace")
-        throw std::invalid_argument("key '" + e.key + "' is not a key name (a-z, space, backspace)");
+      if (std::find(kKeys.begin(), kKeys.end(), e.key) == kKeys.end()) {
+        std::string names;
+        for (const auto& k : kKeys) names += (names.empty() ? "" : ", ") + k;
+        throw std::invalid_argument("key '" + e.key + "' is not a key the viewer acts on (" + names + ")");
+      }
     } else if (key == "file") {
       e.file = text(v, key);
     } else if (key == "dt" && v.is_number()) {  // set: a number as --dt takes it; text, as the panel
@@ -99,6 +103,10 @@ Event from_json(const nlohmann::json& j) {
   if (e.kind == Event::Kind::press && e.button != "left" && e.button != "right" && e.button != "middle")
     throw std::invalid_argument("button must be left, right or middle");
   if (e.kind == Event::Kind::screenshot && e.file.empty()) throw std::invalid_argument("a screenshot needs a file");
+  if (e.kind == Event::Kind::screenshot && std::filesystem::path(e.file).extension() != ".png")
+    throw std::invalid_argument("screenshot '" + e.file + "': expected a file name ending in .png (screenshots are PNG)");
+  if (e.kind == Event::Kind::set && e.settings.empty())
+    throw std::invalid_argument("a set event needs one of pipeline, integrator, dt and options");
   return e;
 }
 

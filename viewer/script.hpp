@@ -17,11 +17,15 @@ struct Event {
   double x = 0, y = 0;          // cursor, pixels from the window's top left (press, move); scroll offset
   std::string button = "left";  // press: left, right, middle
   bool shift = false;           // press: with shift held (left: toggles a pin)
-  std::string key;              // key: its name (space, n, r, w, m, backspace)
+  std::string key;              // key: its name, one of kKeys
   // set: any of "pipeline", "integrator", "dt", "options" (NAME=VALUE, ...) to change.
   std::map<std::string, std::string> settings;
   std::string file;  // screenshot: the PNG to write
 };
+
+// The keys the viewer acts on, by the names scripts give them (the panel lists what each does);
+// the window passes on no others.
+inline const std::vector<std::string> kKeys = {"space", "backspace", "c", "m", "n", "p", "r", "v", "w"};
 
 // Throws std::invalid_argument naming the file and the first bad event.
 std::vector<Event> read_script(const std::string& path);

@@ -6,6 +6,7 @@
 #include <imgui/backends/imgui_impl_glfw.h>
 #include <imgui/backends/imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "gl/context.hpp"
@@ -16,14 +17,13 @@ namespace {
 std::string g_glfw_error;
 void on_glfw_error(int, const char* what) { g_glfw_error = what ? what : "unknown GLFW error"; }
 
+// A key's name in kKeys, or "" for a key the viewer does not act on.
 std::string key_name(int key) {
-  switch (key) {
-    case GLFW_KEY_SPACE: return "space";
-    case GLFW_KEY_BACKSPACE: return "backspace";
-    default:
-      if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) return std::string(1, char('a' + key - GLFW_KEY_A));
-      return {};
-  }
+  std::string name;
+  if (key == GLFW_KEY_SPACE) name = "space";
+  else if (key == GLFW_KEY_BACKSPACE) name = "backspace";
+  else if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) name = std::string(1, char('a' + key - GLFW_KEY_A));
+  return std::find(kKeys.begin(), kKeys.end(), name) != kKeys.end() ? name : "";
 }
 
 }  // namespace

@@ -127,7 +127,13 @@ TEST(ViewerScript, MistypedEventsAreRefusedByIndex) {
   EXPECT_EQ(refusal(R"({"frame": "x", "event": "quit"})"), at + "frame must be a whole number >= 0");
   EXPECT_EQ(refusal(R"({"frame": 1.5, "event": "quit"})"), at + "frame must be a whole number >= 0");
   EXPECT_EQ(refusal(R"({"frame": -1, "event": "quit"})"), at + "frame must be a whole number >= 0");
-  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "zz"})"), at + "key 'zz' is not a key name (a-z, space, backspace)");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "zz"})"),
+            at + "key 'zz' is not a key the viewer acts on (space, backspace, c, m, n, p, r, v, w)");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "key", "key": "z"})"),
+            at + "key 'z' is not a key the viewer acts on (space, backspace, c, m, n, p, r, v, w)");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "set"})"), at + "a set event needs one of pipeline, integrator, dt and options");
+  EXPECT_EQ(refusal(R"({"frame": 1, "event": "screenshot", "file": "shot.jpg"})"),
+            at + "screenshot 'shot.jpg': expected a file name ending in .png (screenshots are PNG)");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "move", "x": "left"})"), at + "x must be a number within ±1e6");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "move", "x": 1, "y": 1e300})"), at + "y must be a number within ±1e6");
   EXPECT_EQ(refusal(R"({"frame": 1, "event": "set", "dt": 1e-40})"),
