@@ -477,6 +477,26 @@ void require_start_outside_colliders(const Model& m, const Params& p) {
   }
 }
 
+// A hard drag sets its node on the path each step: a step along it longer than a step may move a
+// node (runaway_factor x extent) would be taken for divergence. `inserted`: the path starts with
+// the way from the node's rest position, not a key of the scene's (`where` names its path).
+void require_drag_steps_in_bound(const Model& m, const Params& p, bool inserted, const std::string& where) {
+  if (!p.drag.active() || p.drag.as_spring) return;
+  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+  const auto& path = p.drag.path;
+  for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+    const double span = double(path[k + 1].t) - double(path[k].t), way = norm(path[k + 1].position - path[k].position);
+    const double step = way * std::min(1.0, double(p.dt) / span);  // a step within the span, or the whole span
+    if (step <= bound) continue;
+    const std::size_t key = k + 1 - std::size_t(inserted);
+    const std::string from = inserted && k == 0 ? "the node's rest position" : "key " + std::to_string(key - 1);
+    throw std::invalid_argument(where + "[" + std::to_string(key) + "]: the handle moves " + significant_trimmed(step, 3) +
+                                " m in a step on its way from " + from + ", more than a step may move a node "
+                                "(runaway_factor x model extent: " + significant_trimmed(bound, 3) +
+                                " m); the step would be taken for divergence (slow the path or use the spring mode)");
+  }
+}
+
 }  // namespace
 
 Params resolve_params(const Scene& s, const Model& m) {
@@ -503,8 +523,12 @@ Params resolve_params(const Scene& s, const Model& m) {
   // The handle takes its node where it rests at t = 0: a path whose first key comes later
   // starts with the way from there to that key, not with a jump onto it. (After the checks,
   // whose messages count the scene's own keyframes.)
-  if (p.drag.active() && p.drag.path.front().t > 0.f)
-    p.drag.path.insert(p.drag.path.begin(), Keyframe{0.f, m.rest_position[p.drag.node]});
+  const bool inserted = p.drag.active() && p.drag.path.front().t > 0.f;
+  if (inserted) p.drag.path.insert(p.drag.path.begin(), Keyframe{0.f, m.rest_position[p.drag.node]});
+  const std::string& node_where = s.drag.node.where;
+  require_drag_steps_in_bound(m, p, inserted,
+                              node_where.ends_with(".node") ? node_where.substr(0, node_where.size() - 4) + "path"
+                                                            : "drag.path");
   return p;
 }
 
