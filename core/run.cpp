@@ -36,11 +36,27 @@ double stability_limit(const Model& m, const Params& p, Integrator i) {
   return std::numeric_limits<double>::infinity();
 }
 
+double damping_limit(const Model& m, const Params& p, Integrator i) {
+  double inv_mass = 0.0;  // the lightest free node's
+  for (float w : m.inv_mass) inv_mass = std::max(inv_mass, double(w));
+  const double gamma = double(p.damping) * inv_mass;
+  // Where each scheme's factor on v' = -gamma v reaches -1 (or +1: RK4) along gamma dt.
+  double reach = 2.0;
+  if (i == Integrator::rk3) reach = 2.5127453266183286;  // root of z^3 - 3z^2 + 6z - 12
+  if (i == Integrator::rk4) reach = 2.785293563405282;   // root of z^3 - 4z^2 + 12z - 24
+  if (i == Integrator::backward_euler || gamma == 0.0) return std::numeric_limits<double>::infinity();
+  return reach / gamma;
+}
+
 std::string stability_hint(const Model& m, const Params& p, Integrator i) {
   const double limit = stability_limit(m, p, i);
   const std::string name(info(i).name);
   std::ostringstream os;
-  if (limit == 0.0) {
+  if (const double damped = damping_limit(m, p, i); p.dt >= damped) {
+    os << "dt = " << p.dt << " s is above " << name << "'s bound for the global damping (damping = " << p.damping
+       << " N s/m: dt < " << damped << " s at the lightest free node): each step reverses and grows the velocities "
+       << "it damps";
+  } else if (limit == 0.0) {
     os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable for dt < "
        << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
   } else if (std::isinf(limit)) {

@@ -85,6 +85,47 @@ TEST(Run, StabilityBoundIsSharpOnASingleSpring) {
   }
 }
 
+// One free node without springs, damped: v' = -(c/m) v. Each scheme's velocity decays 2% below
+// its damping bound and grows, a divergence that names the damping, 2% above it.
+TEST(Run, DampingBoundIsSharpOnAFreeNode) {
+  Model m;
+  m.rest_position = {{0.f, 1.f, 0.f}};
+  m.inv_mass = {100.f};
+  m.build_adjacency();
+  Params p;
+  p.gravity = {};
+  p.damping = 0.5f;  // c/m = 50 /s
+  p.max_steps = 2000;
+  p.runaway_factor = 1e6f;  // 1 km a step: the first steps at 1 m/s move 4 cm, more than the 1 mm a point's extent allows
+  State s0 = rest_state(m);
+  s0.v[0] = {1.f, 0.f, 0.f};
+  for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
+                       Integrator::verlet, Integrator::rk3, Integrator::rk4}) {
+    const double limit = damping_limit(m, p, i);
+    const double reach = i == Integrator::rk3 ? 2.5127453266183286 : i == Integrator::rk4 ? 2.785293563405282 : 2.0;
+    EXPECT_NEAR(limit, reach / 50.0, 1e-12) << info(i).name;
+    for (double f : {0.98, 1.02}) {
+      p.dt = float(f * limit);
+      auto pipe = make_cpu_pipeline({m, p, i}, Precision::f64, false);
+      pipe->set_state(s0);
+      if (f < 1) {
+        EXPECT_NO_THROW(run(*pipe, m, p, {.integrator = i})) << info(i).name << " at 0.98 x its bound";
+        EXPECT_LT(norm(pipe->state().v[0]), 1e-3f) << info(i).name;
+      } else {
+        try {
+          run(*pipe, m, p, {.integrator = i});
+          ADD_FAILURE() << info(i).name << " at 1.02 x its bound did not diverge";
+        } catch (const DivergenceError& e) {
+          EXPECT_NE(std::string(e.what()).find("'s bound for the global damping"), std::string::npos) << e.what();
+        }
+      }
+    }
+  }
+  EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::backward_euler)));
+  p.damping = 0.f;
+  EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::semi_implicit_euler)));
+}
+
 TEST(Run, StopsWhenNoNodeMovesMoreThanTheThreshold) {
   const Model m = test::small_cloth(12, 12);
   Params p = test::small_params();
