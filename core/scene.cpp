@@ -193,7 +193,7 @@ std::array<float, 12> transform(const json& j, const std::string& where) {
 // 1e6 of each other: outside that Gmsh's tolerances (relative to the model's size) fail or
 // spin, or it merges the points of a side much shorter than the others (1e-6 m beside 1000 m
 // ended the process from within Gmsh's threads).
-constexpr double kShortestLength = 1e-6, kLongestLength = 1e6, kLongestRatio = 1e6;  // m, m, 1
+constexpr double kLongestLength = 1e6, kLongestRatio = 1e6;  // m, 1
 float length(const json& j, const std::string& where) {
   const float v = num(j, where, Range::positive);
   if (v < float(kShortestLength) || v > float(kLongestLength)) bad(where, "expected a length within [1e-6, 1e6] m");

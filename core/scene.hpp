@@ -66,6 +66,11 @@ struct ModelSpec {
 };
 
 // The drag node: an index, "center" or the node nearest a point (resolved once the model exists).
+// The shortest length a model takes (a grid's spacing, a generated mesh's sizes, a file mesh's
+// springs), m: below it the spring force's floor on |d|^2 (node_physics.h) is within reach of
+// float rounding.
+constexpr double kShortestLength = 1e-6;
+
 struct DragSpec {
   bool enabled = false;
   NodeSelector node = {NodeSelector::Kind::index, -1};

@@ -1,7 +1,9 @@
 #include "scene_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -146,6 +148,15 @@ Model mesh_model_of(const ModelSpec& spec) {
   return naming(what, [&] {
     check_memory(mesh);
     Model m = mesh_model(mesh, spec.material, spec.mesh.density);
+    const auto shortest = std::min_element(m.rest_length.begin(), m.rest_length.end());
+    if (shortest != m.rest_length.end() && double(*shortest) < kShortestLength) {
+      const auto s = shortest - m.rest_length.begin();
+      std::ostringstream os;
+      os << "the spring between nodes " << m.file_index(m.spring_i[s]) << " and " << m.file_index(m.spring_j[s]) << " is "
+         << std::setprecision(3) << *shortest << " m long, shorter than the 1e-6 m a model's lengths take (a mesh in "
+         << "other units: its \"scale\")";
+      throw std::invalid_argument(os.str());
+    }
     m.repairs = std::move(notes);
     return m;
   });
