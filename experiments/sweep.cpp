@@ -127,7 +127,8 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     else if (k == "steps") s.steps = positive(v, w + ".steps");
     else if (k == "repetitions") s.repetitions = positive(v, w + ".repetitions");
     else if (k == "cell_limit_s") {
-      if (!v.is_number() || !(v.get<double>() > 0)) bad(w + ".cell_limit_s", "expected a positive number");
+      if (!v.is_number() || !(v.get<double>() >= 0.01 && v.get<double>() <= 1e6))
+        bad(w + ".cell_limit_s", "expected a number of seconds from 0.01 to 1e6");
       s.cell_limit_s = v.get<double>();
     } else if (k == "time") {
       if (v != "update" && v != "frame") bad(w + ".time", "expected \"update\" or \"frame\" (update + render)");

@@ -48,6 +48,8 @@ const std::vector<BadInput>& cases() {
   static const std::vector<BadInput> all = {
       // flags
       {"unknown_pipeline", "run --pipeline warp", "unknown pipeline 'warp' (valid: best, "},
+      {"sweep_cell_limit_tiny", "experiment {dir}/x.json", "x.json.sweep.cell_limit_s: expected a number of seconds from 0.01 to 1e6",
+       {{"x.json", R"({"base": "quick", "sweep": {"sizes": [8], "pipelines": ["cpu"], "cell_limit_s": 1e-300}})"}}},
       {"experiment_unknown_pipeline", "experiment {dir}/x.json", "x.json.pipeline: unknown pipeline 'warp' (valid: best, ",
        {{"x.json", R"({"base": "quick", "pipeline": "warp"})"}}},
       {"unknown_integrator", "run --integrator leapfrog", "unknown integrator 'leapfrog' (valid: explicit-euler, "},

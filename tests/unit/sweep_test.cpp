@@ -485,9 +485,10 @@ TEST_F(SweepTest, MeshesExperimentCells) {
 }
 
 TEST_F(SweepTest, SlowCellsAreCutWithTheReason) {
-  const Experiment x = tiny(R"({"sizes": [8], "pipelines": ["cpu"], "cell_limit_s": 1e-9})");
+  // 512² on cpu by midpoint: milliseconds a step, the cell's steps past the shortest limit.
+  const Experiment x = tiny(R"({"sizes": [512], "pipelines": ["cpu"], "cell_limit_s": 0.01})");
   ModelCache cache;
-  const json r = run_cell(x, *parse_sweep(x.raw, "tiny"), {8, "cpu", "midpoint", {}}, cache);
+  const json r = run_cell(x, *parse_sweep(x.raw, "tiny"), {512, "cpu", "midpoint", {}}, cache);
   EXPECT_EQ(r["status"], "n/a");
   EXPECT_EQ(r["reason"].get<std::string>().rfind("cut: the second step took", 0), 0u) << r.dump();
 }
