@@ -118,6 +118,8 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
   const std::string name = what + " '" + path + "'";
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory)  // a link loop, a name too long
+    throw std::invalid_argument("cannot open " + name + ": " + ec.message());
   if (ec || !fs::exists(st)) throw std::invalid_argument("cannot open " + name + ": no such file");
   if (fs::is_directory(st)) throw std::invalid_argument(name + " is a directory, not a JSON file");
   if (!fs::is_regular_file(st)) throw std::invalid_argument(name + " is not a regular file");

@@ -87,7 +87,8 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
     Scene scene = model_scene(x, s, s.models[k].model, at);
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
-    if (!file.empty() && !std::filesystem::is_regular_file(file, ec)) bad(w + ".file", "'" + file + "': no such file");
+    if (!file.empty() && !std::filesystem::is_regular_file(file, ec))
+      bad(w + ".file", "'" + file + "': " + (ec && ec != std::errc::no_such_file_or_directory ? ec.message() : "no such file"));
     check_mesh_file(scene);  // its errors name the file, or the key (pins, the drag node)
   }
 }

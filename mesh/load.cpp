@@ -263,6 +263,7 @@ Mesh read_gmsh_model(const std::string& what, std::vector<std::string>* notes) {
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   std::error_code ec;
   const auto st = std::filesystem::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) bad(path, ec.message());  // a link loop, a name too long
   if (ec || !std::filesystem::exists(st)) bad(path, "no such file");
   if (std::filesystem::is_directory(st)) bad(path, "a directory, not a mesh file");
   if (!std::filesystem::is_regular_file(st)) bad(path, "not a regular file");

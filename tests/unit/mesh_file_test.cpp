@@ -112,6 +112,15 @@ TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
   };
   const std::string at = "mesh file '" + (dir_ / "").string();
   EXPECT_EQ(error("none.obj", ""), at + "none.obj': no such file");
+  std::filesystem::create_symlink("loop.obj", dir_ / "loop.obj");  // a link to itself: named as such
+  Scene loop;
+  apply_json(loop, nlohmann::json{{"model", {{"type", "mesh"}, {"file", "loop.obj"}, {"pins", "none"}}}}, "s", dir_.string());
+  try {
+    build_model(loop);
+    ADD_FAILURE() << "a link loop was read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), at + "loop.obj': Too many levels of symbolic links");
+  }
   EXPECT_EQ(error("e.obj", ""), at + "e.obj': the file is empty");
   EXPECT_EQ(error("n.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), at + "n.obj': a vertex has a NaN or infinite coordinate (nan, 0, 0)");
   EXPECT_EQ(error("l.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"), at + "l.obj': no triangles");
