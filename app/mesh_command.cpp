@@ -48,7 +48,8 @@ int mesh_command(const MeshArgs& a) {
       throw std::invalid_argument("--out '" + a.out + "': expected a file name ending in .msh");
     require_name_lengths(a.out, "--out");
     if (std::error_code ec; fs::is_directory(a.out, ec)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
-    const Scene scene = chosen_scene(a);
+    Scene scene = chosen_scene(a);
+    scene.model.mesh.order = NodeOrder::file;  // written as Gmsh makes it: a run orders the nodes it reads
     const MeshSpec& ms = scene.model.mesh;
     if (!makes_mesh(scene.model))
       throw std::invalid_argument("the scene's model (" + describe(scene.model) +
