@@ -317,8 +317,8 @@ int run_command(const RunArgs& a) {
     if (const double limit = damping_limit(in.model, in.params, in.integ); in.params.dt >= limit)
       std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
                 << "'s bound for the global damping (damping = " << in.params.damping << " N s/m: dt < "
-                << significant(limit, 3) << " s at the lightest free node): each step reverses and grows the "
-                << "velocities it damps, and the run diverges\n";
+                << significant(limit, 3) << " s at the lightest free node): each step grows the velocities it "
+                << "damps, and the run diverges\n";
     if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
       std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
                 << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";

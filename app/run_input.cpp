@@ -261,15 +261,13 @@ std::string stop_rule_start(const Params& p) {
 
 namespace {
 
-// The checks that need the pipeline's entry, once it is known.
-void check_pipeline(const RunArgs& a, RunInput& in) {
+// The options on the model, once the pipeline is known.
+void check_pipeline(const RunInput& in) {
   try {
     check_options(*in.entry, in.options, in.x.scene.model.topology);
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }
-  if (a.compare && in.entry->name == "reference")
-    throw BadInput("--compare reference: the pipeline run is 'reference' itself");
 }
 
 // read_run_input, or for `view` read_run_model: no output folder, and the pipeline left for
@@ -297,15 +295,17 @@ RunInput read(const RunArgs& a, bool view) {
     throw BadInput("--gl-device: pipeline '" + in.entry->name + "' runs no OpenGL pass, and no --frames are drawn");
   apply_model_flags(a, in.x.scene.model);
   apply_param_flags(a, in.x.scene.params);
-  if (a.compare && *a.compare != "reference")
-    throw BadInput("--compare '" + *a.compare +
-                   "': the only pipeline to compare with is 'reference' (double precision)");
-  if (in.entry) check_pipeline(a, in);
+  if (in.entry) check_pipeline(in);
   in.until_converged = a.until_converged || (in.x.until_converged && !a.steps);
   if (a.threshold && !in.until_converged)
     throw BadInput("--threshold applies to a run until converged (--until-converged); this one takes a fixed number "
                    "of steps");
   check_records_fit(in.x.scene.params);
+  if (a.compare && *a.compare != "reference")
+    throw BadInput("--compare '" + *a.compare +
+                   "': the only pipeline to compare with is 'reference' (double precision)");
+  if (a.compare && in.entry && in.entry->name == "reference")
+    throw BadInput("--compare reference: the pipeline run is 'reference' itself");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
   if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
@@ -331,7 +331,7 @@ void resolve_pipeline(const RunArgs& a, RunInput& in) {
   if (!in.entry) {
     in.entry = find_pipeline(in.x, in.integ);
     in.options = parse_options(a.options, in.entry);
-    check_pipeline(a, in);
+    check_pipeline(in);
     check_fits(in, bool(a.compare), in.model.size());
   }
   require_runs(in.entry, in.x, in.integ);

@@ -37,10 +37,12 @@ double stability_limit(const Model& m, const Params& p, Integrator i) {
 }
 
 double damping_limit(const Model& m, const Params& p, Integrator i) {
-  double inv_mass = 0.0;  // the lightest free node's
-  for (float w : m.inv_mass) inv_mass = std::max(inv_mass, double(w));
+  double inv_mass = 0.0;  // the lightest free node's (a hard-dragged node follows its path)
+  for (int n = 0; n < m.node_count(); ++n)
+    if (!(p.drag.active() && !p.drag.as_spring && n == p.drag.node)) inv_mass = std::max(inv_mass, double(m.inv_mass[n]));
   const double gamma = double(p.damping) * inv_mass;
-  // Where each scheme's factor on v' = -gamma v reaches -1 (or +1: RK4) along gamma dt.
+  // Where each scheme's factor on v' = -gamma v reaches 1 in size along gamma dt: -1 for the
+  // Euler schemes, Verlet and RK3, +1 for midpoint and RK4.
   double reach = 2.0;
   if (i == Integrator::rk3) reach = 2.5127453266183286;  // root of z^3 - 3z^2 + 6z - 12
   if (i == Integrator::rk4) reach = 2.785293563405282;   // root of z^3 - 4z^2 + 12z - 24
@@ -54,8 +56,7 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i) {
   std::ostringstream os;
   if (const double damped = damping_limit(m, p, i); p.dt >= damped) {
     os << "dt = " << p.dt << " s is above " << name << "'s bound for the global damping (damping = " << p.damping
-       << " N s/m: dt < " << damped << " s at the lightest free node): each step reverses and grows the velocities "
-       << "it damps";
+       << " N s/m: dt < " << damped << " s at the lightest free node): each step grows the velocities it damps";
   } else if (limit == 0.0) {
     os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable for dt < "
        << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";

@@ -25,8 +25,8 @@ double stability_limit(const Model& m, const Params& p, Integrator i);
 // The largest time step for which `i` keeps the global damping (f = -c v) from growing the
 // velocity it damps: r m_min / c, r = 2 for the Euler schemes, midpoint and Verlet, 2.51 for
 // RK3 and 2.79 for RK4 (their stability intervals on the negative real axis), m_min the lightest
-// free node's mass; exact for a free node without springs. Infinite without damping and for
-// backward Euler.
+// free node's mass (a hard-dragged node is not free); exact for a free node without springs.
+// Infinite without damping and for backward Euler.
 double damping_limit(const Model& m, const Params& p, Integrator i);
 // What a divergence message says about the step: the bound and where dt lies against it.
 std::string stability_hint(const Model& m, const Params& p, Integrator i);

@@ -387,6 +387,7 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
     const auto& p = j["path"];
     if (!p.is_array() || p.empty()) bad(where + ".path", "expected a non-empty list of [t, x, y, z]");
     h.path.clear();
+    d.path_where = where + ".path";
     for (std::size_t k = 0; k < p.size(); ++k) {
       const std::string w = where + ".path[" + std::to_string(k) + "]";
       if (!p[k].is_array() || p[k].size() != 4) bad(w, "expected [t, x, y, z]");
@@ -478,21 +479,29 @@ void require_start_outside_colliders(const Model& m, const Params& p) {
 }
 
 // A hard drag sets its node on the path each step: a step along it longer than a step may move a
-// node (runaway_factor x extent) would be taken for divergence. `inserted`: the path starts with
-// the way from the node's rest position, not a key of the scene's (`where` names its path).
+// node (runaway_factor x extent) would be taken for divergence. The path is linear between keys,
+// so the longest step starts or ends on a key (or at t = 0, from the node's rest position).
+// `inserted`: the path's first key is the rest position, not one of the scene's (`where` names
+// the scene's path).
 void require_drag_steps_in_bound(const Model& m, const Params& p, bool inserted, const std::string& where) {
   if (!p.drag.active() || p.drag.as_spring) return;
-  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3), dt = p.dt;
   const auto& path = p.drag.path;
-  for (std::size_t k = 0; k + 1 < path.size(); ++k) {
-    const double span = double(path[k + 1].t) - double(path[k].t), way = norm(path[k + 1].position - path[k].position);
-    const double step = way * std::min(1.0, double(p.dt) / span);  // a step within the span, or the whole span
+  std::vector<double> starts = {0.0};
+  for (const Keyframe& k : path) starts.insert(starts.end(), {double(k.t), double(k.t) - dt});
+  for (const double t : starts) {
+    if (t < 0 || t >= double(path.back().t)) continue;
+    const Vec3f from = t == 0 ? m.rest_position[p.drag.node] : p.drag.target(t);
+    const double step = norm(p.drag.target(t + dt) - from);
     if (step <= bound) continue;
-    const std::size_t key = k + 1 - std::size_t(inserted);
-    const std::string from = inserted && k == 0 ? "the node's rest position" : "key " + std::to_string(key - 1);
-    throw std::invalid_argument(where + "[" + std::to_string(key) + "]: the handle moves " + significant_trimmed(step, 3) +
-                                " m in a step on its way from " + from + ", more than a step may move a node "
-                                "(runaway_factor x model extent: " + significant_trimmed(bound, 3) +
+    std::size_t key = 0;  // the key the step heads for (the first one at t = 0, where the step jumps onto it)
+    if (t > 0 || inserted)
+      while (key + 1 < path.size() && double(path[key].t) < t + dt) ++key;
+    throw std::invalid_argument(where + "[" + std::to_string(key - std::size_t(inserted)) + "]: the handle moves " +
+                                significant_trimmed(step, 3) + " m in the step from t = " + significant_trimmed(t, 6) +
+                                " s" + (t == 0 ? " (from the node's rest position)" : "") +
+                                ", more than a step may move a node (runaway_factor x model extent: " +
+                                significant_trimmed(bound, 3) +
                                 " m); the step would be taken for divergence (slow the path or use the spring mode)");
   }
 }
@@ -525,10 +534,7 @@ Params resolve_params(const Scene& s, const Model& m) {
   // whose messages count the scene's own keyframes.)
   const bool inserted = p.drag.active() && p.drag.path.front().t > 0.f;
   if (inserted) p.drag.path.insert(p.drag.path.begin(), Keyframe{0.f, m.rest_position[p.drag.node]});
-  const std::string& node_where = s.drag.node.where;
-  require_drag_steps_in_bound(m, p, inserted,
-                              node_where.ends_with(".node") ? node_where.substr(0, node_where.size() - 4) + "path"
-                                                            : "drag.path");
+  require_drag_steps_in_bound(m, p, inserted, s.drag.path_where);
   return p;
 }
 

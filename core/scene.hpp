@@ -65,16 +65,17 @@ struct ModelSpec {
   std::string pins_where;
 };
 
-// The drag node: an index, "center" or the node nearest a point (resolved once the model exists).
 // The shortest length a model takes (a grid's spacing, a generated mesh's sizes, a file mesh's
 // springs), m: below it the spring force's floor on |d|^2 (node_physics.h) is within reach of
 // float rounding.
 constexpr double kShortestLength = 1e-6;
 
+// The drag node: an index, "center" or the node nearest a point (resolved once the model exists).
 struct DragSpec {
   bool enabled = false;
-  NodeSelector node = {NodeSelector::Kind::index, -1};
+  NodeSelector node = NodeSelector::node(-1);
   bool offsets = true;  // path positions are offsets from the node's rest position
+  std::string path_where = "drag.path";  // the scene key the path was read from, for errors
 };
 
 struct Scene {

@@ -27,16 +27,26 @@ namespace deformlab {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".deformlab-staging-";
+
 void require_name_lengths(const fs::path& path, const std::string& what) {
   std::error_code ec;
   const std::string full = fs::absolute(path, ec).string();
   if (full.size() >= PATH_MAX)
     throw std::invalid_argument(what + " '" + path.string() + "': a path of " + std::to_string(full.size()) +
                                 " bytes, longer than a path may be (" + std::to_string(PATH_MAX - 1) + ")");
-  for (const auto& part : path)
-    if (part.string().size() > NAME_MAX)
-      throw std::invalid_argument(what + " '" + path.string() + "': a name of " + std::to_string(part.string().size()) +
-                                  " bytes, longer than a file name may be (" + std::to_string(NAME_MAX) + ")");
+  // The last name keeps room for the suffix of its temporary (temporary(): the tag and a pid).
+  const std::size_t last = NAME_MAX - kTemporaryTag.size() - 10;
+  for (auto part = path.begin(); part != path.end(); ++part) {
+    const std::size_t bytes = part->string().size(), most = std::next(part) == path.end() ? last : NAME_MAX;
+    if (bytes > most)
+      throw std::invalid_argument(what + " '" + path.string() + "': a name of " + std::to_string(bytes) +
+                                  " bytes, longer than " + std::to_string(most) +
+                                  (most < NAME_MAX ? " (" + std::to_string(NAME_MAX) +
+                                                         ", the most a file name takes, less room for its temporary's "
+                                                         "suffix)"
+                                                   : ", the most a file name takes"));
+  }
 }
 
 void require_folder_or_nothing(const fs::path& dir) {
@@ -97,8 +107,6 @@ std::string foreign_frames_entry(const fs::path& frames) {
   }
   return "";
 }
-
-constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".deformlab-staging-";
 
 fs::path temporary(const fs::path& name) { return name.string().append(kTemporaryTag) + std::to_string(::getpid()); }
 

@@ -19,7 +19,8 @@
 namespace deformlab {
 
 // Throws std::invalid_argument, naming `what`, where `path` holds a name longer than a file
-// name may be (NAME_MAX, 255 bytes) or is itself longer than a path may be (PATH_MAX).
+// name may be (NAME_MAX, 255 bytes; the last name 25 less, for its temporary's suffix) or is
+// itself longer than a path may be (PATH_MAX).
 void require_name_lengths(const std::filesystem::path& path, const std::string& what);
 // Throws std::invalid_argument when `dir` exists and is not a folder, or its name is too long.
 void require_folder_or_nothing(const std::filesystem::path& dir);

@@ -192,8 +192,8 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   constexpr std::size_t kMaxId = 200;
   for (const Cell& c : cells(s)) {
     if (c.id().size() > kMaxId)
-      bad(w, "cell '" + c.id() + "' takes a file name of " + std::to_string(c.id().size()) + " bytes, more than " +
-                 std::to_string(kMaxId) + ": shorten its model's name or its options' values");
+      bad(w, "cell '" + c.id() + "' has a name of " + std::to_string(c.id().size()) + " bytes, more than " +
+                 std::to_string(kMaxId) + " (its file's name): shorten its model's name or its options' values");
     try {
       check_options(*pipelines().find(c.pipeline), c.options,
                     !c.model.empty() ? Topology::general : s.lattice ? Topology::lattice : Topology::cloth_grid);

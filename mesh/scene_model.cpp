@@ -149,7 +149,7 @@ Model mesh_model_of(const ModelSpec& spec) {
     check_memory(mesh);
     Model m = mesh_model(mesh, spec.material, spec.mesh.density);
     const auto shortest = std::min_element(m.rest_length.begin(), m.rest_length.end());
-    if (shortest != m.rest_length.end() && double(*shortest) < kShortestLength) {
+    if (shortest != m.rest_length.end() && *shortest < float(kShortestLength)) {
       const auto s = shortest - m.rest_length.begin();
       std::ostringstream os;
       os << "the spring between nodes " << m.file_index(m.spring_i[s]) << " and " << m.file_index(m.spring_j[s]) << " is "

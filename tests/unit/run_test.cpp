@@ -122,6 +122,10 @@ TEST(Run, DampingBoundIsSharpOnAFreeNode) {
     }
   }
   EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::backward_euler)));
+  p.drag = {0, {{0.f, {}}, {1.f, {}}}, false, 1.f};  // hard-dragged: the node follows its path, not its velocity
+  EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::semi_implicit_euler)));
+  p.drag.as_spring = true;  // pulled by a spring: free, and damped
+  EXPECT_NEAR(damping_limit(m, p, Integrator::semi_implicit_euler), 2.0 / 50.0, 1e-12);
   p.damping = 0.f;
   EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::semi_implicit_euler)));
 }
