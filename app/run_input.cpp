@@ -75,8 +75,34 @@ void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator in
   require_supports(entry, x, integ);
 }
 
+// Throws unless a pipeline of this build that reads every option of `o` accepts their values:
+// what can be checked of options before a pipeline is chosen. Kinds this build lacks read no
+// values (no read_options) and are passed over; with no pipeline left to ask, it passes.
+void require_some_reader(const PipelineOptions& o) {
+  std::string names, first;
+  for (const auto& [name, value] : o) names += (names.empty() ? "" : ", ") + name;
+  bool any = false;
+  for (const PipelineEntry& e : pipelines().all()) {
+    if (!std::all_of(o.begin(), o.end(), [&](const auto& kv) {
+          return std::find(e.options.begin(), e.options.end(), kv.first) != e.options.end();
+        }))
+      continue;
+    any = true;
+    if (!e.read_options) continue;
+    try {
+      check_options(e, o);
+      return;
+    } catch (const std::invalid_argument& x) {
+      if (first.empty()) first = x.what();
+    }
+  }
+  if (!any) throw BadInput("--option: no pipeline has all of the options " + names);
+  if (!first.empty()) throw BadInput("--option: no pipeline reads these values (" + first + ")");
+}
+
 // --option NAME=VALUE flags, each an option the pipeline reads, with a value it can read; with no
-// pipeline chosen yet (`view`'s best, before its window), each an option some pipeline reads.
+// pipeline chosen yet (`view`'s best, before its window), options some pipeline reads with their
+// values.
 PipelineOptions parse_options(const std::vector<std::string>& flags, const PipelineEntry* entry) {
   PipelineOptions options;
   for (const auto& o : flags) {
@@ -91,8 +117,12 @@ PipelineOptions parse_options(const std::vector<std::string>& flags, const Pipel
         }))
       throw BadInput("--option '" + o + "': no pipeline has an option '" + name + "'");
   }
+  if (!entry) {
+    if (!options.empty()) require_some_reader(options);
+    return options;
+  }
   try {
-    if (entry) check_options(*entry, options);
+    check_options(*entry, options);
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }

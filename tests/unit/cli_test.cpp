@@ -536,6 +536,8 @@ TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
            {"--pipeline cpu --option tile=8x8", "option 'tile' is not an option of cpu (it has none)"},
            {"--option bogus=1", "--option 'bogus=1': no pipeline has an option 'bogus'"},
            {"--option =", "--option '=': expected NAME=VALUE"},
+           {"--option window=4 --option tile=8x8", "--option: no pipeline has all of the options tile, window"},
+           {"--option math=quick", "--option: no pipeline reads these values ("},
            {"--pipeline glsl-tf --integrator backward-euler", "integrator 'backward-euler' is not available on glsl-tf"},
            {"--lattice 2000x2000x2000", "a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
            {"--pipeline cpu --lattice 2000x2000x2000", "a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
