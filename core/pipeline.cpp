@@ -1,6 +1,7 @@
 #include "pipeline.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -54,6 +55,14 @@ Math math_option(const PipelineOptions& o) {
   if (it == o.end() || it->second == "exact") return Math::exact;
   if (it->second == "fast") return Math::fast;
   throw std::invalid_argument("option math '" + it->second + "' is not exact or fast");
+}
+
+std::optional<std::int64_t> option_count(std::string_view s, std::int64_t most) {
+  if (s.empty() || s.front() < '1' || s.front() > '9') return std::nullopt;
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || end != s.data() + s.size() || v > most) return std::nullopt;
+  return v;
 }
 
 CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o) {

@@ -4,8 +4,10 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "integrator.hpp"
@@ -74,6 +76,9 @@ enum class Math { exact, fast };
 const char* to_string(Math m);
 // The option "math" ("exact" or "fast"), else exact; throws std::invalid_argument.
 Math math_option(const PipelineOptions& o);
+// A count in an option's value: decimal digits with no sign, space or leading zero, from 1 to
+// `most`, else nothing. One spelling a number, so that option sets that differ differ in value.
+std::optional<std::int64_t> option_count(std::string_view s, std::int64_t most);
 
 // What a pipeline needs to be built.
 struct PipelineSetup {

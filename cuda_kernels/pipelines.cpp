@@ -21,15 +21,11 @@ const char* to_string(Variant v) {
 
 Tile parse_tile(const std::string& s) {
   const auto x = s.find('x');
-  try {
-    std::size_t a = 0, b = 0;
-    if (x == std::string::npos) throw std::invalid_argument(s);
-    const int w = std::stoi(s.substr(0, x), &a), h = std::stoi(s.substr(x + 1), &b);
-    if (a != x || b != s.size() - x - 1 || w < 1 || h < 1 || std::int64_t(w) * h > 1024) throw std::invalid_argument(s);
-    return {w, h};
-  } catch (const std::logic_error&) {
+  const auto w = option_count(std::string_view(s).substr(0, x), 1024);
+  const auto h = x == std::string::npos ? std::nullopt : option_count(std::string_view(s).substr(x + 1), 1024);
+  if (!w || !h || *w * *h > 1024)
     throw std::invalid_argument("CUDA tile '" + s + "' is not WxH with 1..1024 threads (e.g. 32x8)");
-  }
+  return {int(*w), int(*h)};
 }
 
 std::string to_string(Tile t) { return std::to_string(t.x) + "x" + std::to_string(t.y); }
@@ -51,33 +47,25 @@ Tile tile_for(const Options& o, const Model& m) {
 TemporalTile parse_temporal_tile(const std::string& s) {
   TemporalTile t;
   int* axes[] = {&t.x, &t.y, &t.z};
-  std::size_t at = 0;
-  int n = 0;
-  try {
-    for (; n < 3 && at <= s.size(); ++n) {
-      const std::size_t end = std::min(s.find('x', at), s.size());
-      std::size_t used = 0;
-      *axes[n] = std::stoi(s.substr(at, end - at), &used);
-      if (used != end - at || *axes[n] < 1 || *axes[n] > 4096) throw std::invalid_argument(s);
-      at = end + 1;
-    }
-    if (n < 2 || at <= s.size()) throw std::invalid_argument(s);
-  } catch (const std::logic_error&) {
-    throw std::invalid_argument("cuda-temporal tile '" + s + "' is not WxH or WxHxD nodes (e.g. 40x40)");
+  std::size_t at = 0, n = 0;
+  for (; n < 3 && at <= s.size(); ++n) {
+    const std::size_t end = std::min(s.find('x', at), s.size());
+    const auto v = option_count(std::string_view(s).substr(at, end - at), 4096);
+    if (!v) break;
+    *axes[n] = int(*v);
+    at = end + 1;
   }
+  if (n < 2 || at <= s.size())
+    throw std::invalid_argument("cuda-temporal tile '" + s + "' is not WxH or WxHxD nodes (e.g. 40x40)");
   return t;
 }
 
 int steps_per_launch_option(const PipelineOptions& o) {
   const auto it = o.find("steps_per_launch");
   if (it == o.end()) return 0;
-  try {
-    std::size_t used = 0;
-    const int k = std::stoi(it->second, &used);
-    if (used == it->second.size() && k >= 1 && k <= 8) return k;
-  } catch (const std::logic_error&) {
-  }
-  throw std::invalid_argument("option steps_per_launch '" + it->second + "' is not a count from 1 to 8");
+  if (const auto k = option_count(it->second, 8)) return int(*k);
+  throw std::invalid_argument("option steps_per_launch '" + it->second +
+                              "' is not a count from 1 to 8 (plain digits)");
 }
 
 int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps_per_launch : 2; }

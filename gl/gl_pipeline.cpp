@@ -36,17 +36,6 @@ std::int64_t spring_reach(const Model& m) {
   return reach;
 }
 
-// A count option's value: a whole number of at least 1, else nothing.
-std::optional<std::int64_t> parse_count(const std::string& s) {
-  try {
-    std::size_t used = 0;
-    const std::int64_t v = std::stoll(s, &used);
-    if (used == s.size() && v >= 1) return v;
-  } catch (const std::logic_error&) {
-  }
-  return std::nullopt;
-}
-
 // The option "math", its error naming the pipeline.
 Math read_math(const std::string& name, const PipelineOptions& o) {
   try {
@@ -91,8 +80,9 @@ void read_options(const PipelineOptions& o) {
   if (const auto it = o.find("memory"); it != o.end() && it->second != "gl" && it->second != "cuda")
     throw std::invalid_argument("option memory '" + it->second + "' is not one of gl, cuda");
   for (const char* name : {"window", "link_view"})
-    if (const auto it = o.find(name); it != o.end() && !parse_count(it->second))
-      throw std::invalid_argument(std::string("option ") + name + " '" + it->second + "' is not a count of 1 or more");
+    if (const auto it = o.find(name); it != o.end() && !option_count(it->second, INT64_MAX))
+      throw std::invalid_argument(std::string("option ") + name + " '" + it->second +
+                                  "' is not a count of 1 or more (plain digits)");
 }
 
 std::string idle_option(const PipelineOptions& o, Topology t) {
@@ -176,10 +166,10 @@ std::int64_t GlPipeline::count_option(const PipelineOptions& o, const std::strin
                                       const std::string& limit) const {
   const auto it = o.find(name);
   if (it == o.end()) return most;
-  const auto v = parse_count(it->second);
-  if (!v || *v > most)
+  const auto v = option_count(it->second, most);
+  if (!v)
     throw std::invalid_argument(name_ + ": option " + name + " '" + it->second + "' is not a count from 1 to " +
-                                std::to_string(most) + " (" + limit + ")");
+                                std::to_string(most) + " (" + limit + "; plain digits)");
   return *v;
 }
 

@@ -222,13 +222,13 @@ TEST(CudaTemporal, RefusesWhatItDoesNotRun) {
 TEST(CudaTemporal, OptionsAreChecked) {
   EXPECT_EQ(cuda::steps_per_launch_option({{"steps_per_launch", "8"}}), 8);
   EXPECT_EQ(cuda::steps_per_launch_option({}), 0);
-  for (const char* bad : {"0", "9", "2x", "", "-1"})
+  for (const char* bad : {"0", "9", "2x", "", "-1", "02", "+2", " 2"})
     EXPECT_THROW(cuda::steps_per_launch_option({{"steps_per_launch", bad}}), std::invalid_argument) << bad;
   const cuda::TemporalTile t = cuda::parse_temporal_tile("40x24");
   EXPECT_EQ(t.x, 40);
   EXPECT_EQ(t.y, 24);
   EXPECT_EQ(cuda::parse_temporal_tile("7x5x3").z, 3);
-  for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4"})
+  for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4", "040x24", "4x+4"})
     EXPECT_THROW(cuda::parse_temporal_tile(bad), std::invalid_argument) << bad;
   EXPECT_EQ(cuda::steps_per_launch({}), 2);
   EXPECT_EQ(cuda::steps_per_launch(cuda::Options{Variant::temporal, {}, true, Math::exact, 5}), 5);

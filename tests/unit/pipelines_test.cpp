@@ -41,6 +41,16 @@ TEST(Pipelines, TraitsAreTheSameInEveryBuild) {
   EXPECT_THROW(math_option({{"math", "quick"}}), std::invalid_argument);
 }
 
+// A count in an option's value has one spelling: two option sets that read differently differ
+// in value (a sweep runs each set once).
+TEST(Pipelines, OptionCountsHaveOneSpelling) {
+  EXPECT_EQ(option_count("8", 8), 8);
+  EXPECT_EQ(option_count("1", 1), 1);
+  EXPECT_EQ(option_count("9223372036854775807", INT64_MAX), INT64_MAX);
+  for (const char* bad : {"", "0", "9", "08", "+8", " 8", "8 ", "-1", "8x", "0x8", "1e1", "99999999999999999999"})
+    EXPECT_EQ(option_count(bad, 8), std::nullopt) << bad;
+}
+
 // `best` is the first pipeline of the list that runs here, runs the integrator and does not run
 // on a software rasteriser (on a machine with llvmpipe only, a CPU pipeline).
 TEST(Pipelines, BestIsTheFirstThatRunsHereOffSoftwareGl) {
