@@ -77,7 +77,8 @@ const char* to_string(Math m);
 // The option "math" ("exact" or "fast"), else exact; throws std::invalid_argument.
 Math math_option(const PipelineOptions& o);
 // A count in an option's value: decimal digits with no sign, space or leading zero, from 1 to
-// `most`, else nothing. One spelling a number, so that option sets that differ differ in value.
+// `most`, else nothing. One spelling a number, so that a sweep does not take one value spelt two
+// ways for two option sets.
 std::optional<std::int64_t> option_count(std::string_view s, std::int64_t most);
 
 // What a pipeline needs to be built.

@@ -301,7 +301,10 @@ TEST(CudaPipeline, FusedClothsTakeTheTmaWhereItRuns) {
 TEST(CudaPipeline, ParsesTileShapes) {
   EXPECT_EQ(cuda::parse_tile("16x8").x, 16);
   EXPECT_EQ(cuda::parse_tile("16x8").y, 8);
-  for (const char* bad : {"", "16", "0x8", "x8", "16x", "64x64", "8x8x", "a8x8", "016x8", "16x08", "+16x8", " 16x8"})
+  EXPECT_EQ(cuda::parse_tile("1024x1").x, 1024);
+  EXPECT_EQ(cuda::parse_tile("32x32").y, 32);
+  for (const char* bad : {"", "16", "0x8", "x8", "16x", "64x64", "1025x1", "33x32", "8x8x", "a8x8", "016x8", "16x08",
+                          "+16x8", " 16x8"})
     EXPECT_THROW(cuda::parse_tile(bad), std::invalid_argument) << bad;
 }
 

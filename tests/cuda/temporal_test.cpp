@@ -228,7 +228,9 @@ TEST(CudaTemporal, OptionsAreChecked) {
   EXPECT_EQ(t.x, 40);
   EXPECT_EQ(t.y, 24);
   EXPECT_EQ(cuda::parse_temporal_tile("7x5x3").z, 3);
-  for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4", "040x24", "4x+4"})
+  EXPECT_EQ(cuda::parse_temporal_tile("4096x4096x4096").z, 4096);
+  for (const char* bad : {"40", "40x", "x4", "4x4x4x4", "0x4", "4x-1", "4 x4", "040x24", "4x+4", "4x4x", "4x4x0",
+                          "4x4x04", "4097x4"})
     EXPECT_THROW(cuda::parse_temporal_tile(bad), std::invalid_argument) << bad;
   EXPECT_EQ(cuda::steps_per_launch({}), 2);
   EXPECT_EQ(cuda::steps_per_launch(cuda::Options{Variant::temporal, {}, true, Math::exact, 5}), 5);

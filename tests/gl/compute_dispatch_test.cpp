@@ -117,7 +117,7 @@ TEST(LinkViews, TooManyViewsAndBadCountsAreRefused) {
   const Model m = mesh_model(mesh, Material{}, 0.f);
   const Params p = small_params();
   for (const char* name : {"glsl-tf", "glsl-compute"}) {
-    for (const char* bad : {"16", "0", "x"}) {
+    for (const char* bad : {"16", "0", "x", "08", "+8", " 8"}) {
       try {
         make_gl(name, {m, p, Integrator::semi_implicit_euler, {{"link_view", bad}}});
         ADD_FAILURE() << name << " accepted link_view=" << bad;

@@ -180,7 +180,8 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
       {"cuda-temporal", {{"steps_per_launch", "9"}}},
       {"cuda-temporal", {{"tile", "40x"}}},        {"glsl-compute", {{"window", "0"}}},
       {"glsl-tf", {{"link_view", "many"}}},        {"hybrid", {{"interop", "telepathy"}}},
-      {"hybrid-compute", {{"force", "fused"}}},    {"glsl-compute", {{"memory", "host"}}}};
+      {"hybrid-compute", {{"force", "fused"}}},    {"glsl-compute", {{"memory", "host"}}},
+      {"glsl-compute", {{"window", "064"}}},       {"cuda-fused", {{"tile", "32x08"}}}};
   for (const auto& [name, o] : bad) {
     if (r.find(name)->read_options) {
       EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;
