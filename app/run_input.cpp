@@ -83,10 +83,7 @@ void require_some_reader(const PipelineOptions& o) {
   for (const auto& [name, value] : o) names += (names.empty() ? "" : ", ") + name;
   bool any = false;
   for (const PipelineEntry& e : pipelines().all()) {
-    if (!std::all_of(o.begin(), o.end(), [&](const auto& kv) {
-          return std::find(e.options.begin(), e.options.end(), kv.first) != e.options.end();
-        }))
-      continue;
+    if (!std::all_of(o.begin(), o.end(), [&](const auto& kv) { return reads_option(e, kv.first); })) continue;
     any = true;
     if (!e.read_options) continue;
     try {
@@ -112,9 +109,7 @@ PipelineOptions parse_options(const std::vector<std::string>& flags, const Pipel
     if (!options.emplace(name, o.substr(eq + 1)).second)
       throw BadInput("--option '" + o + "': option '" + name + "' is given twice");
     const auto& all = pipelines().all();
-    if (!entry && std::none_of(all.begin(), all.end(), [&](const PipelineEntry& e) {
-          return std::find(e.options.begin(), e.options.end(), name) != e.options.end();
-        }))
+    if (!entry && std::none_of(all.begin(), all.end(), [&](const PipelineEntry& e) { return reads_option(e, name); }))
       throw BadInput("--option '" + o + "': no pipeline has an option '" + name + "'");
   }
   if (!entry) {

@@ -69,9 +69,13 @@ CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o) {
   return math_option(o) == Math::fast ? CpuMatch::rounding : e.traits.cpu_match;
 }
 
+bool reads_option(const PipelineEntry& e, const std::string& name) {
+  return std::find(e.options.begin(), e.options.end(), name) != e.options.end();
+}
+
 void check_options(const PipelineEntry& e, const PipelineOptions& o) {
   for (const auto& [name, value] : o)
-    if (std::find(e.options.begin(), e.options.end(), name) == e.options.end())
+    if (!reads_option(e, name))
       throw std::invalid_argument("option '" + name + "' is not an option of " + e.name +
                                   (e.options.empty() ? " (it has none)" : ""));
   if (!e.read_options) return;

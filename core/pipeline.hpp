@@ -155,6 +155,9 @@ PipelineEntry described(const std::string& name, std::function<std::string()> un
 // where the options choose fast math.
 CpuMatch cpu_match(const PipelineEntry& e, const PipelineOptions& o);
 
+// Whether `e` reads the option `name`.
+bool reads_option(const PipelineEntry& e, const std::string& name);
+
 // Throws std::invalid_argument, naming `e`, at the first option of `o` that `e` does not read
 // or whose value it cannot read: what a run or a sweep checks before anything runs.
 void check_options(const PipelineEntry& e, const PipelineOptions& o);

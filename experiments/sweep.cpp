@@ -53,8 +53,7 @@ namespace {
 
 // Whether `pipeline` reads the option `name`.
 bool reads(const std::string& pipeline, const std::string& name) {
-  const auto& names = pipelines().find(pipeline)->options;
-  return std::find(names.begin(), names.end(), name) != names.end();
+  return reads_option(*pipelines().find(pipeline), name);
 }
 
 std::vector<std::string> strings(const json& j, const std::string& where) {

@@ -217,7 +217,7 @@ std::vector<Case> cases() {
         if (runs(e, s)) out.push_back({e.name, i.id, s});
     }
     for (const auto& [option, values, shapes, integs, with] : kOptionValues) {
-      if (std::find(e.options.begin(), e.options.end(), option) == e.options.end()) continue;
+      if (!reads_option(e, option)) continue;
       for (const std::string& v : values)
         for (Integrator i : integs)
           for (int s : shapes) {
