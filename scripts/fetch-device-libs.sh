@@ -2,7 +2,7 @@
 # Adds to .gl/ the Debian packages of the mesh libraries' runtime (assimp, Gmsh and what they
 # load) that a GPU machine without Debian's libraries lacks; .gl/prelude.sh unpacks every
 # package there. Libraries every Linux image has (libc, libstdc++, zlib, ...) stay out: they
-# would replace the machine's own. Run once after ../shared/device/fetch-gl-debs.sh, from here:
+# would replace the machine's own. Run once .gl/ holds the GL packages and its prelude.sh:
 #   scripts/fetch-device-libs.sh [build/default/app/deformlab]
 set -euo pipefail
 cd "$(dirname "$0")/.."
