@@ -78,12 +78,19 @@ void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator in
 // Throws unless a pipeline of this build that reads every option of `o` accepts their values:
 // what can be checked of options before a pipeline is chosen. Kinds this build lacks read no
 // values (no read_options) and are passed over; with no pipeline left to ask, it passes.
+// Pipelines with no GL pass that are unavailable here are passed over too (a GL pipeline's
+// availability is known only once the window has made its context).
 void require_some_reader(const PipelineOptions& o) {
-  std::string names, first;
+  std::string names, first, unavailable;
   for (const auto& [name, value] : o) names += (names.empty() ? "" : ", ") + name;
   bool any = false;
   for (const PipelineEntry& e : pipelines().all()) {
     if (!std::all_of(o.begin(), o.end(), [&](const auto& kv) { return reads_option(e, kv.first); })) continue;
+    if (!is_gl(e.traits.force) && !is_gl(e.traits.update))
+      if (const std::string why = e.unavailable(); !why.empty()) {
+        if (unavailable.empty()) unavailable = e.name + ": " + why;
+        continue;
+      }
     any = true;
     if (!e.read_options) continue;
     try {
@@ -93,6 +100,8 @@ void require_some_reader(const PipelineOptions& o) {
       if (first.empty()) first = x.what();
     }
   }
+  if (!any && !unavailable.empty())
+    throw BadInput("--option: no pipeline available here has all of the options " + names + " (" + unavailable + ")");
   if (!any) throw BadInput("--option: no pipeline has all of the options " + names);
   if (!first.empty()) throw BadInput("--option: no pipeline reads these values (" + first + ")");
 }

@@ -550,6 +550,21 @@ TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
   }
 }
 
+// With `best`, an option only pipelines unavailable here read is refused before the window, with
+// the reason (cuda-temporal alone reads steps_per_launch).
+TEST_F(Cli, ViewRefusesAnOptionOnlyUnavailablePipelinesRead) {
+  const Result probe = run("run --pipeline cuda-temporal --grid 8x8 --steps 1 --no-state --out " + (dir_ / "p").string());
+  const Result r = run("view --option steps_per_launch=2");
+  if (r.err.find("view needs a build with") != std::string::npos) GTEST_SKIP() << r.err;
+  const std::string refused = "deformlab: error: pipeline 'cuda-temporal' is not available: ";
+  EXPECT_EQ(r.code, 2);
+  if (probe.err.rfind(refused, 0) == 0 && probe.err.back() == '\n')
+    EXPECT_EQ(r.err, "deformlab: error: --option: no pipeline available here has all of the options steps_per_launch "
+                     "(cuda-temporal: " + probe.err.substr(refused.size(), probe.err.size() - refused.size() - 1) + ")\n");
+  else  // available: the check passes, and the window is next
+    EXPECT_EQ(r.err.find("--option"), std::string::npos) << r.err;
+}
+
 // --gl-device picks the GPU of a run's OpenGL context: a pipeline with no GL pass makes one only
 // to draw --frames.
 TEST_F(Cli, GlDeviceNeedsAGlPassOrFrames) {
