@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "availability.hpp"
 #include "core/pipeline.hpp"
 
 struct float4;
@@ -93,8 +94,6 @@ Tile tile_for(const Options& o, const Model& m);
 // fastest on cloths; on lattices, whose halo grows in three axes, 4 fits no tile).
 int steps_per_launch(const Options& o);
 
-// Empty when a CUDA device can be used, else the reason (no driver, no device).
-std::string unavailable();
 // Empty when variant v runs this integrator, else the reason.
 std::string unsupported(Integrator i, Variant v);
 

@@ -1,6 +1,5 @@
-// Device discovery, memory checks and the benchmarks' references: the copy bandwidth and the
+// Device properties, memory checks and the benchmarks' references: the copy bandwidth and the
 // bare gather.
-#include <mutex>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
@@ -19,20 +18,6 @@ std::int64_t buffer_bytes() { return g_buffer_bytes; }
 void fail(cudaError_t e, const std::string& what) {
   throw std::runtime_error("CUDA error while " + what + ": " + cudaGetErrorName(e) + " (" + cudaGetErrorString(e) +
                            ")");
-}
-
-std::string unavailable() {
-  static std::once_flag once;
-  static std::string why;
-  std::call_once(once, [] {
-    int count = 0;
-    const cudaError_t e = cudaGetDeviceCount(&count);
-    if (e != cudaSuccess)
-      why = std::string("no usable CUDA driver or device (cudaGetDeviceCount: ") + cudaGetErrorString(e) + ")";
-    else if (count == 0)
-      why = "no CUDA device";
-  });
-  return why;
 }
 
 void require_device_memory(std::int64_t bytes, const std::string& what) {
