@@ -76,10 +76,11 @@ void require_runs(const PipelineEntry* entry, const Experiment& x, Integrator in
 }
 
 // Throws unless a pipeline of this build that reads every option of `o` accepts their values:
-// what can be checked of options before a pipeline is chosen. Kinds this build lacks read no
-// values (no read_options) and are passed over; with no pipeline left to ask, it passes.
-// Pipelines with no GL pass that are unavailable here are passed over too (a GL pipeline's
-// availability is known only once the window has made its context).
+// what can be checked of options before a pipeline is chosen. Pipelines with no GL pass that
+// are unavailable here (CUDA's without a device or in a build without CUDA) are passed over,
+// and named where no other pipeline has the options. Those with a GL pass are asked only for
+// values, where this build has them (read_options): whether they run here is known only once
+// the window has made its context. With no pipeline left to ask, it passes.
 void require_some_reader(const PipelineOptions& o) {
   std::string names, first, unavailable;
   for (const auto& [name, value] : o) names += (names.empty() ? "" : ", ") + name;
