@@ -1,5 +1,6 @@
 // Whether this machine can run the CUDA pipelines: a driver, a device, and code of this build
-// that the device loads.
+// that the device loads (asked of this file's kernel: every CUDA file of a build is compiled for
+// the same architectures).
 #include <cuda_runtime.h>
 
 #include <mutex>
@@ -39,8 +40,7 @@ std::string unavailable() {
     cudaFuncAttributes a{};
     if (e = cudaFuncGetAttributes(&a, probe); e == cudaSuccess) return;
     cudaGetLastError();  // clear it for later checks
-    const bool no_code = e == cudaErrorNoKernelImageForDevice || e == cudaErrorInvalidDeviceFunction ||
-                         e == cudaErrorUnsupportedPtxVersion;
+    const bool no_code = e == cudaErrorNoKernelImageForDevice || e == cudaErrorInvalidDeviceFunction;
     int device = 0;
     cudaDeviceProp p{};
     if (no_code && cudaGetDevice(&device) == cudaSuccess && cudaGetDeviceProperties(&p, device) == cudaSuccess)
