@@ -9,14 +9,12 @@
 #include "core/cpu_backend.hpp"
 #include "cuda_kernels/cuda_pipeline.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 
 // Every test that needs a device skips cleanly without one (no driver, no GPU).
-#define DEFORMLAB_REQUIRE_CUDA()                                          \
-  do {                                                                    \
-    if (const std::string why = cuda::unavailable(); !why.empty()) GTEST_SKIP() << why; \
-  } while (0)
+#define DEFORMLAB_REQUIRE_CUDA() DEFORMLAB_SKIP_IF_UNAVAILABLE(cuda::unavailable())
 
 // The same springs, seen as a general model: the kernels then gather over the CSR adjacency.
 inline Model as_general(const Model& m) { return explicit_springs(m); }

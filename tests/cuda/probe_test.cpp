@@ -4,13 +4,14 @@
 #include <gtest/gtest.h>
 
 #include "cuda_kernels/availability.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab {
 namespace {
 
 TEST(CudaProbe, ADeviceWithoutThisBuildsCodeIsUnavailableWithTheSettingToAddIt) {
   int count = 0;
-  if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) GTEST_SKIP() << "no CUDA device";
+  if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) DEFORMLAB_SKIP_IF_UNAVAILABLE("no CUDA device");
   cudaDeviceProp p{};
   ASSERT_EQ(cudaGetDeviceProperties(&p, 0), cudaSuccess);
   const std::string why = cuda::unavailable();

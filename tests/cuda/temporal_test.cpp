@@ -14,6 +14,7 @@
 
 #include "cuda_kernels/pipelines.hpp"
 #include "cuda_test_support.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -237,7 +238,7 @@ TEST(CudaTemporal, OptionsAreChecked) {
   EXPECT_FALSE(cuda::unsupported(Integrator::rk4, Variant::temporal).empty());
   EXPECT_EQ(cuda::unsupported(Integrator::verlet, Variant::temporal), "");
   // What a pipeline tells the run about its launches.
-  if (const std::string why = cuda::unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(cuda::unavailable());
   const Model m = small_cloth(4, 4);
   const Params p = small_params();
   EXPECT_EQ(cuda::make_pipeline({m, p, Integrator::verlet}, temporal(3, {}, Math::exact))->steps_per_launch(), 3);

@@ -8,12 +8,9 @@
 #include "core/pipeline.hpp"
 #include "gl/context.hpp"
 #include "gl/pipelines_internal.hpp"
+#include "tests/support/gpu_required.hpp"
 
-#define DEFORMLAB_REQUIRE_GL()                                                \
-  do {                                                                        \
-    if (const std::string why = ::deformlab::gl::unavailable_reason(); !why.empty()) \
-      GTEST_SKIP() << why;                                                    \
-  } while (0)
+#define DEFORMLAB_REQUIRE_GL() DEFORMLAB_SKIP_IF_UNAVAILABLE(::deformlab::gl::unavailable_reason())
 
 namespace deformlab::test {
 

@@ -13,6 +13,7 @@
 #include "gl/context.hpp"
 #include "interop/shared_buffers.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 using Chosen = std::map<std::string, std::string>;
 
 TEST(GlMemory, DefaultChosenForThisMachineAndRecorded) {
-  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(gl::unavailable_reason());
   const std::string why = interop::cuda_memory().unavailable();
   const Model m = small_cloth(8, 8);
   const Params p = small_params();
@@ -58,8 +59,8 @@ class GlMemoryAgrees : public testing::TestWithParam<std::tuple<const char*, Int
 
 TEST_P(GlMemoryAgrees, BitwiseEqualStates) {
   const auto [name, integ, mesh] = GetParam();
-  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
-  if (const std::string why = interop::cuda_memory().unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(gl::unavailable_reason());
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(interop::cuda_memory().unavailable());
   const Model m = make_model(mesh);
   Params p = moving_params(m, integ);
   p.ground = 0.995f;

@@ -7,12 +7,13 @@
 #include "experiments/pipelines.hpp"
 #include "interop/gl_positions.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
 
 TEST(GlPositions, HoldTheCudaPipelinesPositionsAfterEachStep) {
-  if (const std::string why = interop::unavailable(interop::Mode::map); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(interop::unavailable(interop::Mode::map));
   const Model m = small_cloth(33, 17);
   auto p = pipelines().find("cuda-fused")->make({m, small_params(), Integrator::semi_implicit_euler});
   p->set_state(perturbed_state(m, 3u));

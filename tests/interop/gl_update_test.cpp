@@ -11,6 +11,7 @@
 #include "gl/gl_pipeline.hpp"
 #include "gl/pipelines_internal.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -66,7 +67,7 @@ struct Case {
 class GlUpdatePass : public testing::TestWithParam<Case> {};
 
 TEST_P(GlUpdatePass, MatchesTheCpuPipeline) {
-  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(gl::unavailable_reason());
   const Case& c = GetParam();
   Model m = small_cloth(16, 12);
   m.damping = {0.02f, 0.02f, 0.01f};

@@ -10,17 +10,14 @@
 #include "cuda_kernels/cuda_pipeline.hpp"
 #include "interop/hybrid.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
 
 using namespace deformlab::interop;
 
-#define DEFORMLAB_REQUIRE_INTEROP(mode)                                          \
-  do {                                                                           \
-    if (const std::string why = ::deformlab::interop::unavailable(mode); !why.empty()) \
-      GTEST_SKIP() << why;                                                       \
-  } while (0)
+#define DEFORMLAB_REQUIRE_INTEROP(mode) DEFORMLAB_SKIP_IF_UNAVAILABLE(::deformlab::interop::unavailable(mode))
 
 struct Scenario {
   Model model;

@@ -13,6 +13,7 @@
 
 #include "gl/objects.hpp"
 #include "interop/shared_buffers.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -24,7 +25,7 @@ class Modes : public testing::TestWithParam<std::tuple<Mode, int>> {};
 TEST_P(Modes, RoundTripsCarryEachRoundsValues) {
   const Mode m = std::get<0>(GetParam());
   const int n = std::get<1>(GetParam());  // floats
-  if (const std::string why = unavailable(m); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(unavailable(m));
   auto sb = make_shared_buffers(m);
   const GLuint in = sb->add(n * 4, CudaAccess::read), out = sb->add(n * 4, CudaAccess::write);
   const gl::Program copy = gl::make_program({{GL_COMPUTE_SHADER, "copy.comp"}});

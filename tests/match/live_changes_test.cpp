@@ -14,6 +14,7 @@
 #include "experiments/pipelines.hpp"
 #include "tests/match/pipeline_names.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -50,7 +51,7 @@ std::vector<State> drive(Pipeline& p, const Model& m, const State& s0) {
 
 TEST_P(LiveChanges, DragHandleReplacedBetweenStepsAsOnCpu) {
   const PipelineEntry& e = entry();
-  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(e.unavailable());
   Model m = small_cloth(kSide, kSide);
   m.damping = {0.02f, 0.02f, 0.01f};
   const Params p = small_params();
@@ -83,7 +84,7 @@ TEST_P(LiveChanges, DragHandleReplacedBetweenStepsAsOnCpu) {
 
 TEST_P(LiveChanges, StateHandedOverArrivesBitForBit) {
   const PipelineEntry& e = entry();
-  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(e.unavailable());
   const Model m = small_cloth(kSide, kSide);
   State s = perturbed_state(m, 9u);
   s.t = 0.125;
@@ -98,7 +99,7 @@ TEST_P(LiveChanges, StateHandedOverArrivesBitForBit) {
 
 TEST_P(LiveChanges, RefusesAHandleOutsideTheModel) {
   const PipelineEntry& e = entry();
-  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(e.unavailable());
   const Model m = small_cloth(8, 8);
   auto p = e.make({m, small_params(), Integrator::semi_implicit_euler});
   EXPECT_THROW(p->set_drag({64, {{0.f, {}}}}), std::invalid_argument);

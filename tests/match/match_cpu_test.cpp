@@ -33,6 +33,7 @@
 #endif
 #include "experiments/pipelines.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -147,7 +148,7 @@ class MatchCpu : public testing::TestWithParam<Case> {};
 TEST_P(MatchCpu, FiftyStepsFromAMovingState) {
   const Case& c = GetParam();
   const PipelineEntry& e = *pipelines().find(c.pipeline);
-  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(e.unavailable());
   const Model m = make_model(kShapes[c.shape]);
   const Params p = make_params(kShapes[c.shape], m, c.integrator);
   const State s0 = perturbed_state(m, 7u + unsigned(c.shape));

@@ -13,6 +13,7 @@
 #include "experiments/pipelines.hpp"
 #include "tests/match/pipeline_names.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -21,7 +22,7 @@ class StepBack : public testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     e_ = pipelines().find(GetParam());
-    if (const std::string why = e_->unavailable(); !why.empty()) GTEST_SKIP() << why;
+    DEFORMLAB_SKIP_IF_UNAVAILABLE(e_->unavailable());
   }
   void lagged_checks_end_where_waiting_checks_end(Integrator integ);
   void takes_the_last_launch_back_once(Integrator integ);
@@ -188,7 +189,7 @@ TEST(StepBackPipelines, PingPongPipelinesCanStepBack) {
       EXPECT_EQ(e.make({m, p, Integrator::verlet})->can_step_back(), can.count(e.name) == 1) << e.name << " (verlet)";
     }
   }
-  if (seen == 0) GTEST_SKIP() << "no GPU pipeline on this machine";
+  if (seen == 0) DEFORMLAB_SKIP_IF_UNAVAILABLE("no GPU pipeline on this machine");
 }
 
 // The GPU pipelines, every one of which steps back (above); the CPU's checks wait for each step.

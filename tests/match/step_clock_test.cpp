@@ -12,6 +12,7 @@
 #include "experiments/pipelines.hpp"
 #include "tests/match/pipeline_names.hpp"
 #include "tests/support/test_states.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -22,7 +23,7 @@ bool device_clock(const std::string& clock) { return clock == "CUDA events" || c
 
 TEST_P(StepClock, TimesEveryStepWithinTheDrainedWallTime) {
   const PipelineEntry& e = *pipelines().find(GetParam());
-  if (const std::string why = e.unavailable(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(e.unavailable());
   Params p = small_params();
   p.max_steps = 40;
   p.check_every = p.max_steps;  // one check, at the end: nothing drains the device before it

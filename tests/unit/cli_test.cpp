@@ -10,6 +10,7 @@
 
 #include "cli_support.hpp"
 #include "core/memory.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -102,7 +103,10 @@ TEST_F(Cli, RunWritesItsEnergiesEveryKSteps) {
     const fs::path at = dir_ / gpu;
     const Result g = run(std::string("run --pipeline ") + gpu + " --grid 8x6 --steps 130 --energy 50 --no-state --out " +
                          at.string());
-    if (g.code == 2 && g.err.find("is not available") != std::string::npos) continue;
+    if (g.code == 2 && g.err.find("is not available") != std::string::npos) {
+      EXPECT_FALSE(test::gpu_required()) << g.err;
+      continue;
+    }
     ASSERT_EQ(g.code, 0) << gpu << ": " << g.err;
     const auto gm = nlohmann::json::parse(slurp(at / "manifest.json"));
     EXPECT_NEAR(gm["energy"]["last_total_J"].get<double>(), rows[3][5], 1e-4 * std::abs(rows[3][5])) << gpu;
@@ -232,13 +236,14 @@ TEST_F(Cli, GpuRunSaysTheClockItsStepsRanAt) {
   const fs::path out = dir_ / "run";
   const Result r = run("run --pipeline glsl-compute --grid 16x16 --steps 20 --warmup-ms 0 --no-state --out " +
                        out.string());
-  if (r.err.find("is not available") != std::string::npos) GTEST_SKIP() << r.err;
+  if (r.err.find("is not available") != std::string::npos) DEFORMLAB_SKIP_IF_UNAVAILABLE(r.err);
   ASSERT_EQ(r.code, 0) << r.err;
   // Its checks' time is the host's, waiting for the device (a CPU run's: below).
   EXPECT_NE(r.out.find("s  (host clock, waiting for the device)\n"), std::string::npos) << r.out;
   const auto m = nlohmann::json::parse(slurp(out / "manifest.json"));
   const nlohmann::json& clock = m["result"]["sm_clock"];
   if (clock.is_null()) {
+    EXPECT_FALSE(test::gpu_required()) << "a run on a GPU machine's GL reads its clock (NVML)";
     EXPECT_NE(r.out.find("  clock: SM clock not read"), std::string::npos) << r.out;
     return;
   }
@@ -577,7 +582,7 @@ TEST_F(Cli, GlDeviceNeedsAGlPassOrFrames) {
   EXPECT_EQ(bare.err, "deformlab: error: --gl-device: pipeline 'cpu' runs no OpenGL pass, and no --frames are drawn\n");
   EXPECT_FALSE(fs::exists(dir_ / "bare"));
   const Result framed = run(args + (dir_ / "framed").string() + " --frames 2");
-  if (framed.err.find("OpenGL unavailable") != std::string::npos) GTEST_SKIP() << framed.err;
+  if (framed.err.find("OpenGL unavailable") != std::string::npos) DEFORMLAB_SKIP_IF_UNAVAILABLE(framed.err);
   EXPECT_EQ(framed.code, 0) << framed.err;
   EXPECT_TRUE(fs::exists(dir_ / "framed" / "frames")) << framed.err;
 }
@@ -660,7 +665,7 @@ TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
                       "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2, "frames": 1}})");
   const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
   if (r.code == 0 && slurp(dir_ / "r" / "manifest.json").find("OpenGL") != std::string::npos)
-    GTEST_SKIP() << "no OpenGL here: no frames are drawn";
+    DEFORMLAB_SKIP_IF_UNAVAILABLE("no OpenGL here: no frames are drawn");
   EXPECT_EQ(r.code, 2);
   const std::string line = r.err.substr(r.err.rfind("deformlab: error: "));
   EXPECT_EQ(line.rfind("deformlab: error: the experiment's own scene, whose frames its sweep draws (sweep.frames): a "
@@ -674,7 +679,7 @@ TEST_F(Cli, ExperimentRefusesFramesOfASceneThatDoesNotFitTheHost) {
 TEST_F(Cli, TemporalRunNotesChecksThatCutItsLaunches) {
   const std::string args = "run --pipeline cuda-temporal --integrator verlet --grid 24x24 --steps 8 --no-state --out ";
   const Result every = run(args + (dir_ / "every").string());
-  if (every.err.find("is not available") != std::string::npos) GTEST_SKIP() << every.err;
+  if (every.err.find("is not available") != std::string::npos) DEFORMLAB_SKIP_IF_UNAVAILABLE(every.err);
   EXPECT_EQ(every.code, 0) << every.err;
   EXPECT_NE(every.err.find("note: cuda-temporal runs 2 steps a launch; checking the stop rule every 1 step(s)"),
             std::string::npos) << every.err;
@@ -687,7 +692,7 @@ TEST_F(Cli, TemporalRunNotesThatLatticesRunFasterOnCudaFused) {
   const std::string args = "run --pipeline cuda-temporal --integrator semi-implicit-euler --steps 4 --check-every 2 "
                            "--no-state --out ";
   const Result lattice = run(args + (dir_ / "lattice").string() + " --lattice 9x8x7");
-  if (lattice.err.find("is not available") != std::string::npos) GTEST_SKIP() << lattice.err;
+  if (lattice.err.find("is not available") != std::string::npos) DEFORMLAB_SKIP_IF_UNAVAILABLE(lattice.err);
   EXPECT_EQ(lattice.code, 0) << lattice.err;
   EXPECT_NE(lattice.err.find("note: on lattices cuda-temporal took longer a step than cuda-fused"), std::string::npos)
       << lattice.err;

@@ -15,6 +15,7 @@
 #include "core/integrator.hpp"
 #include "core/timed_work.hpp"
 #include "experiments/pipelines.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab {
 namespace {
@@ -138,7 +139,7 @@ TEST(Pipelines, WorkTimedBackToBackSpansItsTime) {
 TEST(Pipelines, ClockWatchedOnTheGpuThatRunsThem) {
   EXPECT_EQ(gpu_bus_id(*pipelines().find("cpu")), "");
   EXPECT_EQ(gpu_bus_id(*pipelines().find("omp")), "");
-  if (!ClockWatch::available()) GTEST_SKIP() << "no NVIDIA driver's NVML here";
+  if (!ClockWatch::available()) DEFORMLAB_SKIP_IF_UNAVAILABLE("no NVIDIA driver's NVML here");
   for (const char* name : {"cuda-fused", "glsl-compute", "glsl-tf", "hybrid"}) {
     const PipelineEntry& e = *pipelines().find(name);
     if (!e.unavailable().empty()) continue;

@@ -16,6 +16,7 @@
 #include "viewer/orbit.hpp"
 #include "viewer/script.hpp"
 #include "viewer/session.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -221,7 +222,7 @@ TEST(ViewerPicking, FindsTheNodeNearestTheCursorOnScreen) {
 
 // The depth under the cursor gives the point of the surface there, on the node drawn there.
 TEST(ViewerPicking, SurfaceUnderTheCursorIsWhereTheNodeIs) {
-  if (const std::string why = gl::unavailable_reason(); !why.empty()) GTEST_SKIP() << why;
+  DEFORMLAB_SKIP_IF_UNAVAILABLE(gl::unavailable_reason());
   const Model m = small_cloth(20, 20);
   gl::Renderer r(m, {.width = 400, .height = 300});
   r.draw(rest_state(m));
