@@ -162,7 +162,7 @@ std::vector<int> select_nodes(const Model& m, const NodeSelector& s) {
                                     " holds no node of the model");
       return out;
     case K::center:
-      if (m.grid()) return {((m.nz / 2) * m.ny + m.ny / 2) * m.nx + m.nx / 2};
+      if (m.grid()) return {Grid::grid_node(m.nx / 2, m.ny / 2, m.nz / 2, m.nx, m.ny)};
       [[fallthrough]];
     case K::nearest: {
       Vec3f target = s.a;
@@ -195,7 +195,7 @@ std::vector<int> pin_nodes(const Model& m, PinSet set, const std::vector<NodeSel
   };
   // "top": cloth row j = 0; lattice layer j = ny-1 (front row k = 0 for corners / row).
   const int top_j = m.topology == Topology::lattice ? m.ny - 1 : 0;
-  auto node = [&](int i, int j, int k) { return (k * m.ny + j) * m.nx + i; };
+  auto node = [&](int i, int j, int k) { return Grid::grid_node(i, j, k, m.nx, m.ny); };
   switch (set) {
     case PinSet::none: break;
     case PinSet::top_corners:

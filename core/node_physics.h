@@ -50,8 +50,7 @@ struct StepParams {
   int sphere_count;
   int nx, ny;           // grid dimensions (node (i, j, k) = (k ny + j) nx + i)
   int nz, node_count;
-  int stencil_count;    // grid stencil entries in use (0: not a grid)
-  int pad;
+  int pad0, pad1;       // std140: the spheres start on 16 bytes
   Sphere spheres[MAX_SPHERES];
 };
 

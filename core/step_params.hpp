@@ -10,6 +10,8 @@
 #include "params.hpp"
 #include "physics.hpp"
 
+static_assert(MAX_STENCIL == deformlab::kLatticeStencil, "node_physics.h's MAX_STENCIL is the largest grid stencil");
+
 namespace deformlab {
 
 // The drag handle's part of the step parameters.
@@ -40,7 +42,6 @@ typename Physics<Real>::StepParams step_params(const Model& m, const Params& p) 
   s.ny = m.ny;
   s.nz = m.nz;
   s.node_count = m.node_count();
-  s.stencil_count = m.grid() ? grid_stencil_size(m.volume()) : 0;
   return s;
 }
 

@@ -6,6 +6,7 @@
 
 #include "check.cuh"
 #include "core/grid_stencil.hpp"
+#include "core/physics.hpp"
 #include "core/timed_work.hpp"
 #include "cuda_pipeline.hpp"
 #include "event_spans.hpp"
@@ -87,7 +88,7 @@ __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* _
   const int node = j * n + i;
   float4 sx = x[node], sv = v[node];
   if (Previous) sx.w += xp[node].x;
-  const bool inside = i >= 2 && i < n - 2 && j >= 2 && j < n - 2;
+  const bool inside = i >= STENCIL_REACH && i < n - STENCIL_REACH && j >= STENCIL_REACH && j < n - STENCIL_REACH;
 #pragma unroll
   for (int g = 0; g < kClothStencil; g += Group) {
     float4 xn[Group], vn[Group];

@@ -168,7 +168,7 @@ class ForceKernels {
     std::size_t shared = 0;
     if (Tiled) {
       const std::size_t cells = std::size_t(o_.tile.x + 2 * dev::kHalo) * (o_.tile.y + 2 * dev::kHalo) *
-                                (N > 12 ? 2 * dev::kHalo + 1 : 1);
+                                (N == kLatticeStencil ? 2 * dev::kHalo + 1 : 1);
       shared = cells * sizeof(float4) * (Damped ? 2 : 1);
       if (shared > 48 * 1024)
         check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),

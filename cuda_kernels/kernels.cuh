@@ -81,7 +81,7 @@ __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stenc
     bool ok[G];
 #pragma unroll
     for (int q = 0; q < G; ++q) {
-      const GridOffset o = grid_offset(N > 12, g + q);
+      const GridOffset o = grid_offset(N == kLatticeStencil, g + q);
       ok[q] = !Checked || P::grid_neighbour(s, i, j, k, o.di, o.dj, o.dk) >= 0;
       if (ok[q]) {
         const int at = w.at(o.di, o.dj, o.dk);
@@ -104,7 +104,7 @@ __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stenc
 template <int N, bool Damped>
 __device__ __forceinline__ Vec3f gather_grid(const StepParams& s, const Stencil& st, int i, int j, int k,
                                              const Vec3f& xi, const Vec3f& vi, const Window& w) {
-  if (P::grid_interior(s, i, j, k, N > 12)) return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
+  if (P::grid_interior(s, i, j, k, N == kLatticeStencil)) return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
   return gather_stencil<N, Damped, true>(s, st, i, j, k, xi, vi, w);
 }
 
@@ -242,7 +242,7 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
   extern __shared__ float4 sh[];
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y, k = blockIdx.z;
   Window w{x, v, 0, s.nx, s.nx * s.ny};
-  if constexpr (Tiled) w = load_tile<(N > 12), Damped>(s, x, v, sh);
+  if constexpr (Tiled) w = load_tile<N == kLatticeStencil, Damped>(s, x, v, sh);
   if (i >= s.nx || j >= s.ny) return;
   const int node = P::grid_node(i, j, k, s.nx, s.ny);
   if constexpr (!Tiled) w.base = node;
@@ -335,7 +335,7 @@ struct TiledCsr {
 };
 
 // Force pass: the block stages its tile's positions (and velocities, if damped) in shared
-// memory, then each member gathers its springs from there in the CSR order of gather_csr.
+// memory, then each member gathers its springs from there (gather_csr over the tile's cells).
 template <bool Damped>
 __global__ void force_tiled_csr(StepParams s, TiledCsr t, const float4* __restrict__ x, const float4* __restrict__ v,
                                 float4* __restrict__ acc, Vec3f drag_target) {
@@ -354,12 +354,8 @@ __global__ void force_tiled_csr(StepParams s, TiledCsr t, const float4* __restri
   Vec3f a{};
   if (!P::node_fixed(s, i, x4.w)) {
     const Vec3f xi = xyz(x4), vi = xyz(v4);
-    Vec3f f{};
-    for (int e = t.link_offset[p]; e < t.link_offset[p + 1]; ++e) {
-      const Link l = t.links[e];
-      f += P::spring_force(xi, xyz(sh[l.node]), vi, Damped ? xyz(sv[l.node]) : vi, l.k, l.kd, l.rest);
-    }
-    a = P::node_acceleration(s, i, x4.w, xi, vi, f, drag_target);
+    a = P::node_acceleration(s, i, x4.w, xi, vi, gather_csr<Damped>(t.link_offset, t.links, sh, sv, p, xi, vi),
+                             drag_target);
   }
   acc[i] = f4(a, 0.f);
 }

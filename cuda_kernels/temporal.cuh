@@ -101,7 +101,7 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
                   const float4* __restrict__ v, const float4* __restrict__ x_prev, bool has_prev,
                   float4* __restrict__ xo, float4* __restrict__ vo, float4* __restrict__ po, StepTargets tg,
                   StopCheck check) {
-  constexpr bool kVolume = N > 12, kVerlet = Rule == RULE_VERLET;
+  constexpr bool kVolume = N == kLatticeStencil, kVerlet = Rule == RULE_VERLET;
   extern __shared__ float4 sh[];
   const Region<kVolume> r(tile, kHalo * steps);
   const int cells = r.count();

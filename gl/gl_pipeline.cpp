@@ -56,7 +56,8 @@ std::string stencil_defines(bool volume) {
     offsets += std::string(e ? ", " : "") + "ivec3(" + std::to_string(o.di) + ", " + std::to_string(o.dj) + ", " +
                std::to_string(o.dk) + ")";
   }
-  return "#define STENCIL_SIZE " + std::to_string(n) + "\n#define STENCIL_OFFSETS ivec3[](" + offsets + ")\n";
+  return "#define STENCIL_SIZE " + std::to_string(n) + "\n#define STENCIL_VOLUME " + (volume ? "true" : "false") +
+         "\n#define STENCIL_OFFSETS ivec3[](" + offsets + ")\n";
 }
 
 std::vector<NodeWindow> node_windows(std::int64_t n, std::int64_t reach, std::int64_t max_nodes, std::int64_t align) {
@@ -412,7 +413,8 @@ State GlPipeline::state() {
 
 void GlPipeline::bind_textures(int stage) const {
   // Units 2-4: velocities of stage states 1..3; 5-7: accelerations at stages 0..2 (sim.glsl),
-  // bound only where this pass reads them; 8-9: the adjacency of general models.
+  // bound only where this pass reads them; 8: the adjacency offsets of general models, 9 and 11-13
+  // their link views (10: the hybrids' accelerations).
   for (int k = 0; k < kMaxStages - 1; ++k) {
     glActiveTexture(GL_TEXTURE2 + k);
     glBindTexture(GL_TEXTURE_BUFFER, k + 1 < stage ? sv_[k].tex.id() : 0);

@@ -31,8 +31,8 @@ std::array<std::uint32_t, 2> dispatch_shape(std::int64_t groups, std::int64_t ma
 inline constexpr int kComputeTileX = 32, kComputeTileY = 8;
 std::string compute_tile_defines();
 
-// The grid stencil for the shaders: STENCIL_SIZE and STENCIL_OFFSETS as defines
-// (core/grid_stencil.hpp's table).
+// The grid stencil for the shaders as defines (core/grid_stencil.hpp's table): STENCIL_SIZE,
+// STENCIL_VOLUME (true for a lattice's) and STENCIL_OFFSETS.
 std::string stencil_defines(bool volume);
 
 }  // namespace deformlab::gl

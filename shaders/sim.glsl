@@ -6,10 +6,10 @@
 // and, on grids, after it (it reads params):
 //   ivec3 node_cell(int i)           node i's grid coordinates (node_physics.h's grid_node inverted)
 // and the host defines PASS (one of the PASS_* below), STAGE (the pass's stage, 0..3),
-// RULE (node_physics.h's RULE_*), TOPOLOGY_GRID (with STENCIL_SIZE and STENCIL_OFFSETS,
-// the stencil's entries and their offsets) or TOPOLOGY_GENERAL, and MATH_EXACT or MATH_FAST
-// (the pipeline option "math": the CPU float pipeline's operations, see exact_math.glsl, or
-// what the driver makes of the plain ones).
+// RULE (node_physics.h's RULE_*), TOPOLOGY_GRID (with STENCIL_SIZE, STENCIL_VOLUME and
+// STENCIL_OFFSETS: the stencil's entries, whether it is a lattice's, and their offsets) or
+// TOPOLOGY_GENERAL, and MATH_EXACT or MATH_FAST (the pipeline option "math": the CPU float
+// pipeline's operations, see exact_math.glsl, or what the driver makes of the plain ones).
 // With EXTERNAL_FORCES (the hybrid pipelines) another API's force pass wrote each node's
 // acceleration, which the including shader reads as vec4 forces_acc(int i).
 
@@ -97,7 +97,7 @@ vec3 springs_on(int i, vec3 xi, vec3 vi) {
   // border check whether each neighbour is in the grid.
   ivec3 c = node_cell(i);
   int layer = params.nx * params.ny;
-  if (grid_interior(params, c.x, c.y, c.z, STENCIL_SIZE != 12)) {
+  if (grid_interior(params, c.x, c.y, c.z, STENCIL_VOLUME)) {
     for (int e = 0; e < STENCIL_SIZE; ++e) {
       ivec3 o = STENCIL_OFFSET(e);
       int j = i + o.x + o.y * params.nx + o.z * layer;

@@ -58,7 +58,7 @@ void main() {
   uint tile_row = gl_WorkGroupID.z * gl_NumWorkGroups.y + gl_WorkGroupID.y;
   int row = u_first_row + int(tile_row * uint(TILE_Y) + gl_LocalInvocationID.y), col = int(gl_GlobalInvocationID.x);
   int l = col < params.nx ? row * params.nx + col - u_first : -1;  // -1: outside the window
-  int k = STENCIL_SIZE > 12 ? row / params.ny : 0;  // rows of layers stacked: row = k ny + j
+  int k = STENCIL_VOLUME ? row / params.ny : 0;  // rows of layers stacked: row = k ny + j
   cell_ = ivec3(col, row - k * params.ny, k);
 #else
   // Work groups run x by y when there are more than the driver's x limit (dispatch_shape).
