@@ -135,4 +135,6 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
   return parse_json(text.str(), name);
 }
 
+void bad_value(const std::string& where, const std::string& what) { throw std::invalid_argument(where + ": " + what); }
+
 }  // namespace deformlab

@@ -47,22 +47,18 @@ std::string Cell::label(bool lattice) const {
 
 namespace {
 
-[[noreturn]] void bad(const std::string& where, const std::string& what) {
-  throw std::invalid_argument(where + ": " + what);
-}
-
 // Whether `pipeline` reads the option `name`.
 bool reads(const std::string& pipeline, const std::string& name) {
   return reads_option(*pipelines().find(pipeline), name);
 }
 
 std::vector<std::string> strings(const json& j, const std::string& where) {
-  if (!j.is_array() || j.empty()) bad(where, "expected a non-empty list of names");
+  if (!j.is_array() || j.empty()) bad_value(where, "expected a non-empty list of names");
   std::vector<std::string> out;
   for (const auto& e : j) {
-    if (!e.is_string()) bad(where, "expected a list of names");
+    if (!e.is_string()) bad_value(where, "expected a list of names");
     if (std::find(out.begin(), out.end(), e.get<std::string>()) != out.end())
-      bad(where, "'" + e.get<std::string>() + "' is named twice");
+      bad_value(where, "'" + e.get<std::string>() + "' is named twice");
     out.push_back(e.get<std::string>());
   }
   return out;
@@ -70,7 +66,7 @@ std::vector<std::string> strings(const json& j, const std::string& where) {
 
 int positive(const json& j, const std::string& where) {
   if (!j.is_number_integer() || j.get<std::int64_t>() < 1 || j.get<std::int64_t>() > 1'000'000)
-    bad(where, "expected a positive integer");
+    bad_value(where, "expected a positive integer");
   return j.get<int>();
 }
 
@@ -80,7 +76,7 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   if (!x.contains("sweep")) return std::nullopt;
   const json& j = x["sweep"];
   const std::string w = where + ".sweep";
-  if (!j.is_object()) bad(w, "expected an object");
+  if (!j.is_object()) bad_value(w, "expected an object");
   Sweep s;
   // The experiment's model type, a base's written in (experiments/experiment.cpp).
   const json* model = x.contains("scene") && x["scene"].is_object() && x["scene"].contains("model")
@@ -89,15 +85,15 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   s.lattice = model && model->is_object() && model->value("type", json()) == "lattice";
   for (const auto& [k, v] : j.items()) {
     if (k == "sizes") {
-      if (!v.is_array() || v.empty()) bad(w + ".sizes", "expected a non-empty list of sizes");
+      if (!v.is_array() || v.empty()) bad_value(w + ".sizes", "expected a non-empty list of sizes");
       for (const auto& n : v) {
         s.sizes.push_back(positive(n, w + ".sizes"));
         if (std::count(s.sizes.begin(), s.sizes.end(), s.sizes.back()) > 1)
-          bad(w + ".sizes", "size " + std::to_string(s.sizes.back()) + " is named twice");
+          bad_value(w + ".sizes", "size " + std::to_string(s.sizes.back()) + " is named twice");
         try {
           check_node_count(std::pow(double(s.sizes.back()), s.lattice ? 3 : 2));
         } catch (const std::invalid_argument& e) {
-          bad(w + ".sizes", "size " + size_label(s.sizes.back(), s.lattice) + ": " + e.what());
+          bad_value(w + ".sizes", "size " + size_label(s.sizes.back(), s.lattice) + ": " + e.what());
         }
       }
     } else if (k == "models") s.models = parse_sweep_models(v, w + ".models");
@@ -105,72 +101,74 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     else if (k == "pipelines") s.pipelines = strings(v, w + ".pipelines");
     else if (k == "integrators") s.integrators = strings(v, w + ".integrators");
     else if (k == "options") {
-      if (!v.is_array() || v.empty()) bad(w + ".options", "expected a non-empty list of option objects");
+      if (!v.is_array() || v.empty()) bad_value(w + ".options", "expected a non-empty list of option objects");
       for (const auto& o : v) {
-        if (!o.is_object()) bad(w + ".options", "expected objects of NAME: \"VALUE\"");
+        if (!o.is_object()) bad_value(w + ".options", "expected objects of NAME: \"VALUE\"");
         PipelineOptions po;
         for (const auto& [name, value] : o.items()) {
-          if (!value.is_string()) bad(w + ".options." + name, "expected a string value");
+          if (!value.is_string()) bad_value(w + ".options." + name, "expected a string value");
           po[name] = value.get<std::string>();
         }
         if (std::find(s.option_sets.begin(), s.option_sets.end(), po) != s.option_sets.end())
-          bad(w + ".options", "an option set is named twice");
+          bad_value(w + ".options", "an option set is named twice");
         s.option_sets.push_back(po);
       }
     } else if (k == "warmup") {
       s.warmup = positive(v, w + ".warmup");
       if (s.warmup < kBoundingSteps)
-        bad(w + ".warmup", "expected at least " + std::to_string(kBoundingSteps) +
-                               " warm-up steps (a cell's first two steps bound its time before it is measured)");
+        bad_value(w + ".warmup", "expected at least " + std::to_string(kBoundingSteps) +
+                                     " warm-up steps (a cell's first two steps bound its time before it is measured)");
     }
     else if (k == "steps") s.steps = positive(v, w + ".steps");
     else if (k == "repetitions") s.repetitions = positive(v, w + ".repetitions");
     else if (k == "cell_limit_s") {
       if (!v.is_number() || !(v.get<double>() >= 0.01 && v.get<double>() <= 1e6))
-        bad(w + ".cell_limit_s", "expected a number of seconds from 0.01 to 1e6");
+        bad_value(w + ".cell_limit_s", "expected a number of seconds from 0.01 to 1e6");
       s.cell_limit_s = v.get<double>();
     } else if (k == "time") {
-      if (v != "update" && v != "frame") bad(w + ".time", "expected \"update\" or \"frame\" (update + render)");
+      if (v != "update" && v != "frame") bad_value(w + ".time", "expected \"update\" or \"frame\" (update + render)");
       s.time = v.get<std::string>();
     } else if (k == "frames") {
       if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > 100)
-        bad(w + ".frames", "expected a number of frames from 0 to 100");
+        bad_value(w + ".frames", "expected a number of frames from 0 to 100");
       s.frames = v.get<int>();
     } else if (k == "paper_table") {
       if (v != "table1" && v != "table2" && v != "table3" && v != "")
-        bad(w + ".paper_table", "expected \"table1\", \"table2\" or \"table3\"");
+        bad_value(w + ".paper_table", "expected \"table1\", \"table2\" or \"table3\"");
       s.paper_table = v.get<std::string>();
     } else
-      bad(w + "." + k, "unknown key (expected sizes, models, orders, pipelines, integrators, options, warmup, "
-                       "steps, repetitions, cell_limit_s, time, frames, paper_table)");
+      bad_value(w + "." + k, "unknown key (expected sizes, models, orders, pipelines, integrators, options, warmup, "
+                             "steps, repetitions, cell_limit_s, time, frames, paper_table)");
   }
   // A cell's timed steps live in memory until it ends, and are counted in an int.
   if (constexpr std::int64_t most = 10'000'000; std::int64_t(s.steps) * s.repetitions > most)
-    bad(w + ".repetitions", std::to_string(s.repetitions) + " batches of " + std::to_string(s.steps) +
-                                " steps: a cell times at most " + std::to_string(most) + " steps");
-  if (s.sizes.empty() == s.models.empty()) bad(w, "needs either sizes or models");
-  if (!s.orders.empty() && s.models.empty()) bad(w + ".orders", "node orders go with models");
-  if (s.pipelines.empty()) bad(w, "needs pipelines");
+    bad_value(w + ".repetitions", std::to_string(s.repetitions) + " batches of " + std::to_string(s.steps) +
+                                      " steps: a cell times at most " + std::to_string(most) + " steps");
+  if (s.sizes.empty() == s.models.empty()) bad_value(w, "needs either sizes or models");
+  if (!s.orders.empty() && s.models.empty()) bad_value(w + ".orders", "node orders go with models");
+  if (s.pipelines.empty()) bad_value(w, "needs pipelines");
   // Without its own list the sweep takes the experiment's integrator (a base's is written into
   // the experiment's JSON), and an error names that key.
   const std::string integrators_key = s.integrators.empty() ? where + ".integrator" : w + ".integrators";
   if (s.integrators.empty()) s.integrators = {x.value("integrator", std::string("semi-implicit-euler"))};
   if (s.option_sets.empty()) s.option_sets = {PipelineOptions{}};
   for (const auto& p : s.pipelines)
-    if (!pipelines().find(p)) bad(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
+    if (!pipelines().find(p))
+      bad_value(w + ".pipelines", "unknown pipeline '" + p + "' (valid: " + pipelines().names() + ")");
   for (std::size_t k = 0; k < s.integrators.size(); ++k) {
     const auto i = parse_integrator(s.integrators[k]);
-    if (!i) bad(integrators_key, "unknown integrator '" + s.integrators[k] + "' (valid: " + integrator_names() + ")");
+    if (!i)
+      bad_value(integrators_key, "unknown integrator '" + s.integrators[k] + "' (valid: " + integrator_names() + ")");
     for (std::size_t e = 0; e < k; ++e)
       if (parse_integrator(s.integrators[e]) == i)
-        bad(integrators_key, "'" + s.integrators[k] + "' names the integrator '" + s.integrators[e] + "' names");
+        bad_value(integrators_key, "'" + s.integrators[k] + "' names the integrator '" + s.integrators[e] + "' names");
   }
   check_models_under_orders(s, w);
   for (const auto& o : s.option_sets)
     for (const auto& entry : o) {
       const std::string& name = entry.first;
       if (std::none_of(s.pipelines.begin(), s.pipelines.end(), [&name](const std::string& p) { return reads(p, name); }))
-        bad(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
+        bad_value(w + ".options." + name, "no pipeline of this sweep reads option '" + name + "'");
     }
   // A pipeline runs a set whose every option it reads (cells): one that reads some of a set
   // would run without it.
@@ -182,22 +180,22 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
         list += (list.empty() ? "" : ", ") + name;
       }
       if (!read.empty() && !unread.empty())
-        bad(w + ".options[" + std::to_string(k) + "]",
-            p + " reads " + read + " but not " + unread + ", so it would run without this set (a pipeline runs the "
-            "sets whose every option it reads: give it a set of its own)");
+        bad_value(w + ".options[" + std::to_string(k) + "]",
+                  p + " reads " + read + " but not " + unread + ", so it would run without this set (a pipeline "
+                  "runs the sets whose every option it reads: give it a set of its own)");
     }
   // Each cell's options as its model reads them: the sweep's grids (its scene's topology) or meshes;
   // its id short enough for a file name with room for its temporary's (output.hpp).
   constexpr std::size_t kMaxId = 200;
   for (const Cell& c : cells(s)) {
     if (c.id().size() > kMaxId)
-      bad(w, "cell '" + c.id() + "' has a name of " + std::to_string(c.id().size()) + " bytes, more than " +
-                 std::to_string(kMaxId) + " (its file's name): shorten its model's name or its options' values");
+      bad_value(w, "cell '" + c.id() + "' has a name of " + std::to_string(c.id().size()) + " bytes, more than " +
+                       std::to_string(kMaxId) + " (its file's name): shorten its model's name or its options' values");
     try {
       check_options(*pipelines().find(c.pipeline), c.options,
                     !c.model.empty() ? Topology::general : s.lattice ? Topology::lattice : Topology::cloth_grid);
     } catch (const std::invalid_argument& e) {
-      bad(w + ".options", e.what());
+      bad_value(w + ".options", e.what());
     }
   }
   return s;
@@ -238,7 +236,8 @@ void require_size_scenes(const Experiment& x, const Sweep& s, const std::string&
     try {
       resolve_params(scene, build_model(scene));
     } catch (const std::invalid_argument& e) {
-      bad(where + ".sweep.sizes[" + std::to_string(k) + "]", "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
+      bad_value(where + ".sweep.sizes[" + std::to_string(k) + "]",
+                      "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
     }
   }
 }

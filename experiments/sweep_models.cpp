@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "core/json_file.hpp"
 #include "mesh/scene_model.hpp"
 
 namespace deformlab {
@@ -12,10 +13,6 @@ namespace deformlab {
 using nlohmann::json;
 
 namespace {
-
-[[noreturn]] void bad(const std::string& where, const std::string& what) {
-  throw std::invalid_argument(where + ": " + what);
-}
 
 // The experiment's scene with model `m`; under a sweep's orders its seed is read for the
 // shuffled order (each cell then takes its own).
@@ -30,40 +27,41 @@ Scene model_scene(const Experiment& x, const Sweep& s, const json& m, const std:
 }  // namespace
 
 std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& where) {
-  if (!j.is_array() || j.empty()) bad(where, "expected a non-empty list of {\"name\": ..., \"model\": {...}}");
+  if (!j.is_array() || j.empty()) bad_value(where, "expected a non-empty list of {\"name\": ..., \"model\": {...}}");
   std::vector<SweepModel> out;
   std::set<std::string> names;
   for (std::size_t k = 0; k < j.size(); ++k) {
     const std::string w = where + "[" + std::to_string(k) + "]";
     const json& e = j[k];
     if (!e.is_object() || e.size() != 2 || !e.contains("name") || !e.contains("model"))
-      bad(w, "expected {\"name\": ..., \"model\": {...}}");
+      bad_value(w, "expected {\"name\": ..., \"model\": {...}}");
     const std::string name = e["name"].is_string() ? e["name"].get<std::string>() : "";
-    if (!is_plain_name(name)) bad(w + ".name", kPlainName);
+    if (!is_plain_name(name)) bad_value(w + ".name", kPlainName);
     if (name.find("__") != std::string::npos)
-      bad(w + ".name", "'" + name + "' holds \"__\", which joins the parts of a cell's name (a cell of another model "
-                       "could take the same name)");
-    if (!names.insert(name).second) bad(w + ".name", "model '" + name + "' is named twice");
+      bad_value(w + ".name", "'" + name + "' holds \"__\", which joins the parts of a cell's name (a cell of "
+                             "another model could take the same name)");
+    if (!names.insert(name).second) bad_value(w + ".name", "model '" + name + "' is named twice");
     // Alone, as under a sweep's orders: its seed read for the shuffled order (model_scene reads
     // it over the experiment's scene before the first cell).
     Scene probe;
     probe.model.topology = Topology::general;
     probe.model.mesh.order = NodeOrder::shuffled;
     apply_json(probe, {{"model", e["model"]}}, w);
-    if (probe.model.topology != Topology::general) bad(w + ".model.type", "sweep models are meshes (\"type\": \"mesh\")");
+    if (probe.model.topology != Topology::general)
+      bad_value(w + ".model.type", "sweep models are meshes (\"type\": \"mesh\")");
     out.push_back({name, e["model"]});
   }
   return out;
 }
 
 std::vector<std::string> parse_sweep_orders(const json& j, const std::string& where) {
-  if (!j.is_array() || j.empty()) bad(where, std::string("expected a non-empty list of: ") + kNodeOrderNames);
+  if (!j.is_array() || j.empty()) bad_value(where, std::string("expected a non-empty list of: ") + kNodeOrderNames);
   std::vector<std::string> out;
   for (const auto& o : j) {
     if (!o.is_string() || !parse_node_order(o.get<std::string>()))
-      bad(where, std::string("expected a list of: ") + kNodeOrderNames);
+      bad_value(where, std::string("expected a list of: ") + kNodeOrderNames);
     if (std::find(out.begin(), out.end(), o.get<std::string>()) != out.end())
-      bad(where, "order '" + o.get<std::string>() + "' is named twice");
+      bad_value(where, "order '" + o.get<std::string>() + "' is named twice");
     out.push_back(o.get<std::string>());
   }
   return out;
@@ -75,9 +73,9 @@ void check_models_under_orders(const Sweep& s, const std::string& where) {
   for (std::size_t k = 0; k < s.models.size(); ++k) {
     const json& m = s.models[k].model;
     const std::string w = where + ".models[" + std::to_string(k) + "].model";
-    if (m.contains("order")) bad(w + ".order", "the sweep's \"orders\" give every cell its order");
+    if (m.contains("order")) bad_value(w + ".order", "the sweep's \"orders\" give every cell its order");
     if (m.contains("seed") && !shuffled)
-      bad(w + ".seed", "seeds the shuffled order, which the sweep's \"orders\" leave out");
+      bad_value(w + ".seed", "seeds the shuffled order, which the sweep's \"orders\" leave out");
   }
 }
 
@@ -88,7 +86,8 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec))
-      bad(w + ".file", "'" + file + "': " + (ec && ec != std::errc::no_such_file_or_directory ? ec.message() : "no such file"));
+      bad_value(w + ".file", "'" + file + "': " +
+                                 (ec && ec != std::errc::no_such_file_or_directory ? ec.message() : "no such file"));
     check_mesh_file(scene);  // its errors name the file, or the key (pins, the drag node)
   }
 }
