@@ -1,7 +1,7 @@
 // The springs of a model, whichever its shape: grids by their stencil, general models by
-// their spring lists and adjacency. Stages that need springs one by one (the implicit solve,
-// energies, the stability bound, scatter) walk them here; the gather kernels read the
-// stencil or the adjacency directly, which is their fast path.
+// their spring lists and adjacency. Stages on the CPU that need springs one by one (the implicit
+// solve, energies, the stability bound) walk them here; the GPU kernels read the stencil, the
+// adjacency or the spring list directly.
 #pragma once
 #include <algorithm>
 #include <cstdint>
