@@ -11,8 +11,9 @@
 #include <sstream>
 #include <string>
 
-namespace deformlab::test {
+#include "core/memory.hpp"
 
+namespace deformlab::test {
 
 namespace fs = std::filesystem;
 
@@ -77,5 +78,11 @@ class Cli : public ::testing::Test {
   }
   fs::path dir_;
 };
+
+// The host memory the programs count against (MemAvailable, or a tighter cgroup limit), GiB.
+inline double available_gib() {
+  const auto limit = host_memory_limit();
+  return limit ? double(limit->bytes) / double(1LL << 30) : 1e9;
+}
 
 }  // namespace deformlab::test
