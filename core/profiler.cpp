@@ -97,13 +97,6 @@ void Profiler::end_stream() {
   if (!ok) throw write_error(stream_path_, stream_error_ ? stream_error_ : errno);
 }
 
-void Profiler::write_csv(const std::string& path) const {
-  write_file(path, [&](std::ostream& f) {
-    f << "name,step,start_ms,ms,clock\n" << std::setprecision(9);
-    for (const Span& s : spans_) write_row(f, s);
-  });
-}
-
 void Profiler::write_trace(const std::string& path) const {
   // One track (tid) per clock, named by metadata events.
   std::vector<std::string> clocks;

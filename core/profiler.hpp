@@ -61,9 +61,9 @@ class Profiler {
   void add(Span s);
   // The spans kept (all of them, unless streamed without keeping them).
   const std::vector<Span>& spans() const { return spans_; }
-  // From now on each span is written to the CSV file `path` as it is added (as write_csv
-  // writes them) and kept in spans() only with `keep`; summary() needs neither. A long run
-  // then holds one number per step and stage instead of its spans.
+  // From now on each span is written to the CSV file `path` as it is added (name,step,start_ms,
+  // ms,clock, one line per span) and kept in spans() only with `keep`; summary() needs neither.
+  // A long run then holds one number per step and stage instead of its spans.
   void stream_csv(const std::string& path, bool keep);
   // Flushes and closes the streamed file (throws std::runtime_error when writing failed).
   void end_stream();
@@ -79,8 +79,6 @@ class Profiler {
   };
   std::vector<Stage> summary() const;
 
-  // name,step,start_ms,ms,clock, one line per span.
-  void write_csv(const std::string& path) const;
   // Chrome trace JSON (complete events; one track per clock), opens in Perfetto. GPU spans
   // are placed at the host time their work was issued, with their GPU-measured durations.
   void write_trace(const std::string& path) const;

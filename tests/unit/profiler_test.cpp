@@ -60,12 +60,13 @@ TEST(Profiler, SamplesWindowsOfStepsFromTheFirst) {
   EXPECT_EQ(p.sampled_count(13), 13);
 }
 
-// Streamed spans: the file holds what write_csv writes, the summary is the same, and
-// without keeping them the profiler holds no spans (a long run's memory stays flat).
+// Streamed spans: the file is the same whether the spans are kept or not, the summary is the
+// same, and without keeping them the profiler holds no spans (a long run's memory stays flat).
 TEST(Profiler, StreamsSpansWithTheSameSummary) {
   const auto dir = std::filesystem::temp_directory_path() / ("deformlab_stream_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   Profiler kept, streamed;
+  kept.stream_csv((dir / "kept.csv").string(), true);
   streamed.stream_csv((dir / "streamed.csv").string(), false);
   for (Profiler* p : {&kept, &streamed})
     for (int step = 1; step <= 50; ++step) {
@@ -74,7 +75,7 @@ TEST(Profiler, StreamsSpansWithTheSameSummary) {
       p->add({span::reductions, step, 0.0, 1.0 / step, "host clock"});
     }
   streamed.end_stream();
-  kept.write_csv((dir / "kept.csv").string());
+  kept.end_stream();
   auto slurp = [](const std::filesystem::path& f) {
     std::ifstream in(f);
     std::stringstream ss;
@@ -98,13 +99,14 @@ TEST(Profiler, StreamsSpansWithTheSameSummary) {
 }
 
 TEST(Profiler, WritesCsvAndAChromeTrace) {
+  const auto dir = std::filesystem::temp_directory_path() / ("deformlab_profiler_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
   Profiler p;
+  p.stream_csv((dir / "spans.csv").string(), true);
   p.set_step(1);
   { HostSpan h(&p, span::step); }
   p.add({span::force, 1, 0.25, 0.125, "CUDA events"});
-  const auto dir = std::filesystem::temp_directory_path() / ("deformlab_profiler_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  p.write_csv((dir / "spans.csv").string());
+  p.end_stream();
   p.write_trace((dir / "trace.json").string());
   std::ifstream csv(dir / "spans.csv");
   std::string header, line;
