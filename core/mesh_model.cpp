@@ -57,7 +57,13 @@ void for_each_index(Mesh& m, F&& f) {
   for (auto& t : m.tetrahedron) for (auto& v : t) f(v);
 }
 
-// Degenerate if a vertex repeats or the size is below 1e-12 of what its longest edge spans.
+// Whether an element's size (area, volume) is below 1e-12 of what its longest edge spans.
+template <std::size_t N, class SizeFn>
+bool zero_size(const Mesh& m, const std::array<std::int32_t, N>& t, SizeFn size) {
+  return !(size(m, t) > 1e-12 * std::pow(longest_edge(m, t), double(N - 1)));
+}
+
+// Degenerate if a vertex repeats or its size is zero.
 template <std::size_t N, class SizeFn>
 void check_elements(const Mesh& m, const std::vector<std::array<std::int32_t, N>>& elements, const char* name,
                     SizeFn size, bool welded) {
@@ -65,8 +71,7 @@ void check_elements(const Mesh& m, const std::vector<std::array<std::int32_t, N>
     const auto& t = elements[e];
     const std::string which = std::string(name) + " " + std::to_string(e);
     if (repeats(t)) bad(which + " is degenerate: a vertex repeats" + (welded ? " (after welding duplicates)" : ""));
-    if (!(size(m, t) > 1e-12 * std::pow(longest_edge(m, t), double(N - 1))))
-      bad(which + " is degenerate: zero " + (N == 3 ? "area" : "volume"));
+    if (zero_size(m, t, size)) bad(which + " is degenerate: zero " + (N == 3 ? "area" : "volume"));
   }
 }
 
@@ -153,6 +158,11 @@ std::vector<std::string> repair(Mesh& m) {
   if (repeated)
     lines.push_back("dropped " + std::to_string(repeated) + " repeated " + (m.volume() ? "tetrahedra" : "triangles"));
   return lines;
+}
+
+bool has_flat_tetrahedron(const Mesh& m) {
+  return std::any_of(m.tetrahedron.begin(), m.tetrahedron.end(),
+                     [&](const auto& t) { return zero_size(m, t, tetrahedron_volume); });
 }
 
 std::int64_t mesh_spring_bound(const Mesh& m) {

@@ -36,6 +36,9 @@ struct Mesh {
 // face shared by more than two tetrahedra.
 std::vector<std::string> repair(Mesh& m);
 
+// Whether some tetrahedron has zero volume (as repair finds it), four vertices in a plane.
+bool has_flat_tetrahedron(const Mesh& m);
+
 // Whether a vertex's coordinates are all finite, and "a vertex has a NaN or infinite coordinate
 // (nan, 0, 0)": that error's words wherever a mesh's vertices are checked. The coordinates name
 // the vertex: a library's vertex order need not be the file's.

@@ -83,6 +83,17 @@ TEST(MeshModel, TetrahedraCountsAreClosedForm) {
   EXPECT_NEAR(total, 1000.0, 1e-3);
 }
 
+// A tetrahedron whose fourth vertex lies in the plane of the other three is flat, by the test that
+// repair refuses it with; one 1e-9 m off the plane of a 1 mm cell is not.
+TEST(MeshModel, FlatTetrahedraAreFound) {
+  Mesh m{{{0, 0, 0}, {1e-3f, 0, 0}, {0, 1e-3f, 0}, {1e-3f, 1e-3f, 0}}, {}, {{0, 1, 2, 3}}};
+  EXPECT_TRUE(has_flat_tetrahedron(m));
+  EXPECT_THROW(repair(m), std::invalid_argument);
+  m.position[3].z = 1e-9f;
+  EXPECT_FALSE(has_flat_tetrahedron(m));
+  EXPECT_TRUE(repair(m).empty());
+}
+
 TEST(MeshModel, SurfaceMassesAreDensityTimesArea) {
   const Model m = model_of(triangulated_square(9, 5, 0.3f), 0.2f);
   double total = 0, area = 0;
