@@ -67,12 +67,14 @@ void require_drag_steps_in_bound(const Model& m, const Params& p, bool inserted,
   std::vector<double> starts = {0.0};
   for (const Keyframe& k : path) starts.insert(starts.end(), {double(k.t), double(k.t) - dt});
   for (const double t : starts) {
-    if (t < 0 || t >= double(path.back().t)) continue;
+    if (t < 0 || (t > 0 && t >= double(path.back().t))) continue;  // the first step moves it from rest
     const Vec3f from = t == 0 ? m.rest_position[p.drag.node] : p.drag.target(t);
     const double step = norm(p.drag.target(t + dt) - from);
     if (step <= bound) continue;
-    std::size_t key = 0;  // the key the step heads for (the first one at t = 0, where the step jumps onto it)
-    if (t > 0 || inserted)
+    // The key the step heads for; the first one where the step from rest jumps onto it, a key at
+    // t = 0 with no other within the step.
+    std::size_t key = 0;
+    if (t > 0 || inserted || (path.size() > 1 && double(path[1].t) <= t + dt))
       while (key + 1 < path.size() && double(path[key].t) < t + dt) ++key;
     throw std::invalid_argument(where + "[" + std::to_string(key - std::size_t(inserted)) + "]: the handle moves " +
                                 significant_trimmed(step, 3) + " m in the step from t = " + significant_trimmed(t, 6) +
