@@ -51,7 +51,16 @@ void require_name_lengths(const fs::path& path, const std::string& what) {
 
 void require_folder_or_nothing(const fs::path& dir) {
   require_name_lengths(dir, "output folder");
+  // What a command writes inside the folder takes up to this much more path: a run's staging
+  // folder and frames, an experiment's cell files (names of up to 200 bytes), each with its
+  // temporary's suffix.
+  constexpr std::size_t kInside = 256;
   std::error_code ec;
+  if (const std::size_t bytes = fs::absolute(dir, ec).string().size(); bytes + kInside >= PATH_MAX)
+    throw std::invalid_argument("output folder '" + dir.string() + "': a path of " + std::to_string(bytes) +
+                                " bytes, which leaves less than the " + std::to_string(kInside) +
+                                " its files' paths may need within the " + std::to_string(PATH_MAX - 1) +
+                                " a path may be");
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
 }

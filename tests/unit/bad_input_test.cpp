@@ -33,6 +33,13 @@ BadInput mesh(const char* name, const std::string& model, const std::string& key
   return {name, "run --pipeline cpu --steps 3 --scene {dir}/s.json", key, {{"s.json", scene}, {file, text}}};
 }
 
+// `s`, n times over.
+std::string repeated(const std::string& s, int n) {
+  std::string out;
+  for (int k = 0; k < n; ++k) out += s;
+  return out;
+}
+
 // A scene whose mesh model is generated from `generate` (its JSON, which may go on with more keys of the model).
 std::string G(const std::string& generate) {
   return "{\"model\": {\"type\": \"mesh\", \"pins\": \"none\", \"generate\": " + generate + "}}";
@@ -108,6 +115,10 @@ const std::vector<BadInput>& cases() {
        "a name of 300 bytes, longer than 230 (255, the most a file name takes, less room for its temporary's suffix)"},
       {"out_folder_name_too_long", "run --grid 4x4 --steps 2 --out {dir}/" + std::string(256, 'q') + "/run",
        "a name of 256 bytes, longer than 255, the most a file name takes"},
+      // 19 names of 200 bytes: a path of over 3800 bytes, whose files' paths would pass 4095
+      {"out_path_too_long_for_its_files",
+       "run --grid 4x4 --steps 2 --out {dir}" + repeated("/" + std::string(200, 'q'), 19),
+       "bytes, which leaves less than the 256 its files' paths may need within the 4095 a path may be"},
       {"experiment_out_name_too_long", "experiment quick --out {dir}/" + std::string(300, 'q'),
        "a name of 300 bytes, longer than 230 (255, the most a file name takes, less room for its temporary's suffix)"},
       {"mesh_out_name_too_long", "mesh --experiment meshes --model bunny-shell --out {dir}/" + std::string(300, 'q') + ".msh",
