@@ -1,5 +1,6 @@
 #include "output.hpp"
 
+#include <fcntl.h>
 #include <sys/utsname.h>
 #include <signal.h>
 #include <unistd.h>
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 
 #include <Eigen/Core>
 #include <fstream>
@@ -127,6 +129,19 @@ void require_file_target(const std::string& file, const std::string& what) {
   if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
   if (!folder.empty() && !fs::is_directory(folder, ec))
     throw std::invalid_argument(what + " '" + file + "': no folder '" + folder.string() + "'");
+  require_file_can_be_made(file, what);
+}
+
+void require_file_can_be_made(const std::string& file, const std::string& what) {
+  std::error_code ec;
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return;  // a pipe, a device: written to as it is
+  // Its temporary, made and removed again.
+  const fs::path probe = temporary(file);
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0)
+    throw std::invalid_argument(what + " '" + file + "': no file can be made there (" + std::strerror(errno) + ")");
+  ::close(fd);
+  fs::remove(probe, ec);
 }
 
 void write_atomically(const fs::path& file, const std::string& text) {

@@ -45,8 +45,12 @@ void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 std::string foreign_frames_entry(const std::filesystem::path& frames);
 
 // Throws std::invalid_argument where `file`, named by `what` (a flag), could not be written: an
-// empty name, a name too long, a folder in its place, or no folder to hold it.
+// empty name, a name too long, a folder in its place, no folder to hold it, or one where no file
+// can be made.
 void require_file_target(const std::string& file, const std::string& what);
+// Throws std::invalid_argument, naming `what`, where no file can be made in the existing folder
+// that is to hold `file` (one the process may not write, a file system that takes none).
+void require_file_can_be_made(const std::string& file, const std::string& what);
 // The temporary name of `name` for this process: "<name>.deformlab-tmp-<pid>". The names of
 // temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other
 // files are never taken for them.

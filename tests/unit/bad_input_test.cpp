@@ -121,6 +121,8 @@ const std::vector<BadInput>& cases() {
        "bytes, which leaves less than the 256 its files' paths may need within the 4095 a path may be"},
       {"experiment_out_name_too_long", "experiment quick --out {dir}/" + std::string(300, 'q'),
        "a name of 300 bytes, longer than 230 (255, the most a file name takes, less room for its temporary's suffix)"},
+      {"mesh_out_where_no_file_can_be_made", "mesh --experiment meshes --model bunny-shell --out /proc/x.msh",
+       "--out '/proc/x.msh': no file can be made there ("},
       {"mesh_out_name_too_long", "mesh --experiment meshes --model bunny-shell --out {dir}/" + std::string(300, 'q') + ".msh",
        ".msh': a name of 304 bytes, longer than 230 (255, the most a file name takes, less room"},
       {"experiment_name_too_long", "experiment {dir}/x.json",

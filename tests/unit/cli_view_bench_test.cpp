@@ -138,6 +138,8 @@ TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
                                                               "the limit of 2^30 nodes"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 8 4", "--sizes: size 4 is named twice"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv ''", "--csv: an empty file name"},
+        std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv /proc/x.csv",
+                  "--csv '/proc/x.csv': no file can be made there"},
         std::pair{"gl --reps 1 --warmup 0 --sizes 4 --integrator backward-euler", "glsl-tf: backward-euler needs"},
         std::pair{"cuda --sizes 64 --graph-sizes 1", "--graph-sizes: size 1: expected 2 or more"},
         // a table's flags where the table is skipped
