@@ -37,6 +37,7 @@ TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
            {"--size 200x1 --record " + (dir_ / "x.mp4").string(), "--record needs a window 2 pixels high or more"},
            {"--record " + (dir_ / "x.txt").string(), "--record '" + (dir_ / "x.txt").string() +
                                                        "': expected a file name ending in .mp4"},
+           {"--summary /proc/x.json", "--summary '/proc/x.json': no file can be made there ("},
            // From here, checks that a build without a viewer does not reach.
            {"--pipeline nope", "unknown pipeline 'nope' (valid: best, "},
            {"--scene " + (dir_ / "none.json").string(), "cannot open scene file '" + (dir_ / "none.json").string()},

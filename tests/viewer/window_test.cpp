@@ -100,13 +100,16 @@ TEST_F(View, AResetEndsTheDrag) {
 }
 
 // A screenshot that cannot be written is said on stderr and in the summary, and the session
-// exits 1; the summary is still written.
+// exits 1; the summary is still written. (Its file is a link to /dev/full, which passes the check
+// before the window, a device being written as it is, and refuses the write.)
 TEST_F(View, AScreenshotThatCannotBeWrittenEndsInExit1) {
-  const fs::path script = write("shot.json", R"({"events": [{"frame": 1, "event": "screenshot", "file": "/proc/x.png"},
-                                                            {"frame": 2, "event": "quit"}]})");
+  const fs::path full = dir_ / "full.png";
+  fs::create_symlink("/dev/full", full);
+  const fs::path script = write("shot.json", R"({"events": [{"frame": 1, "event": "screenshot", "file": ")" +
+                                                  full.string() + R"("}, {"frame": 2, "event": "quit"}]})");
   const Result r = view("--pipeline cpu --script " + script.string() + " --summary " + (dir_ / "summary.json").string());
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find("deformlab: error: cannot write /proc/x.png: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("deformlab: error: cannot write " + full.string() + ": "), std::string::npos) << r.err;
   EXPECT_EQ(summary()["screenshots"][0]["written"], false);
 }
 
