@@ -31,12 +31,16 @@ using nlohmann::json;
 
 constexpr std::string_view kTemporaryTag = ".deformlab-tmp-", kStagingTag = ".deformlab-staging-";
 
-void require_name_lengths(const fs::path& path, const std::string& what) {
+void require_name_lengths(const fs::path& path, const std::string& what, std::size_t inside) {
   std::error_code ec;
   const std::string full = fs::absolute(path, ec).string();
-  if (full.size() >= PATH_MAX)
+  const std::string most = std::to_string(PATH_MAX - 1);
+  if (full.size() + inside >= PATH_MAX)
     throw std::invalid_argument(what + " '" + path.string() + "': a path of " + std::to_string(full.size()) +
-                                " bytes, longer than a path may be (" + std::to_string(PATH_MAX - 1) + ")");
+                                " bytes, " +
+                                (inside ? "which leaves less than the " + std::to_string(inside) +
+                                              " its files' paths may need within the " + most + " a path may be"
+                                        : "longer than a path may be (" + most + ")"));
   // The last name keeps room for the suffix of its temporary (temporary(): the tag and a pid).
   const std::size_t last = NAME_MAX - kTemporaryTag.size() - 10;
   for (auto part = path.begin(); part != path.end(); ++part) {
@@ -52,17 +56,11 @@ void require_name_lengths(const fs::path& path, const std::string& what) {
 }
 
 void require_folder_or_nothing(const fs::path& dir) {
-  require_name_lengths(dir, "output folder");
-  // What a command writes inside the folder takes up to this much more path: a run's staging
+  // What a command writes inside the folder takes up to 256 bytes more path: a run's staging
   // folder and frames, an experiment's cell files (names of up to 200 bytes), each with its
   // temporary's suffix.
-  constexpr std::size_t kInside = 256;
+  require_name_lengths(dir, "output folder", 256);
   std::error_code ec;
-  if (const std::size_t bytes = fs::absolute(dir, ec).string().size(); bytes + kInside >= PATH_MAX)
-    throw std::invalid_argument("output folder '" + dir.string() + "': a path of " + std::to_string(bytes) +
-                                " bytes, which leaves less than the " + std::to_string(kInside) +
-                                " its files' paths may need within the " + std::to_string(PATH_MAX - 1) +
-                                " a path may be");
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw std::invalid_argument("output path '" + dir.string() + "' exists and is not a folder");
 }

@@ -20,8 +20,8 @@ namespace deformlab {
 
 // Throws std::invalid_argument, naming `what`, where `path` holds a name longer than a file
 // name may be (NAME_MAX, 255 bytes; the last name 25 less, for its temporary's suffix) or is
-// itself longer than a path may be (PATH_MAX).
-void require_name_lengths(const std::filesystem::path& path, const std::string& what);
+// itself longer than a path may be (PATH_MAX), less `inside` bytes for the paths below it.
+void require_name_lengths(const std::filesystem::path& path, const std::string& what, std::size_t inside = 0);
 // Throws std::invalid_argument when `dir` exists and is not a folder, or its name is too long,
 // or its path leaves too little room for the paths of the files written inside it.
 void require_folder_or_nothing(const std::filesystem::path& dir);
