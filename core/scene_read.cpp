@@ -200,7 +200,7 @@ MeshShape shape(const json& j, const std::string& where) {
   const auto [shortest, longest] = std::minmax_element(sides.begin(), sides.end());
   if (double(*longest) > kLongestRatio * double(*shortest))
     bad_value(where + ".size",
-                    "its longest side is more than 1e6 times its shortest (Gmsh would merge the shortest's ends)");
+              "its longest side is more than 1e6 times its shortest (Gmsh would merge the shortest's ends)");
   s.cell_size = length(j["cell_size"], where + ".cell_size");
 
   if (j.contains("threads")) {
@@ -259,7 +259,7 @@ void apply_mesh(MeshSpec& m, const json& j, const std::string& where, const std:
   // Keys that would do nothing are refused (the writer leaves them out).
   if (j.contains("cell_size") && !m.fill)
     bad_value(where + ".cell_size",
-                    "the cell size of a tetrahedral fill, and this mesh is not filled (\"fill\": \"tetrahedra\")");
+              "the cell size of a tetrahedral fill, and this mesh is not filled (\"fill\": \"tetrahedra\")");
   if (j.contains("seed") && m.order != NodeOrder::shuffled)
     bad_value(where + ".seed", std::string("seeds the shuffled order, and this mesh's order is ") + to_string(m.order));
 }
@@ -326,7 +326,7 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   for (const char* k : {"stiffness", "damping"})
     if (mesh && j.contains(k) && j[k].is_object() && j[k].contains("shear"))
       bad_value(where + "." + k + ".shear",
-                      "a mesh has no shear springs (its edges are structural, its bending springs flexion)");
+                "a mesh has no shear springs (its edges are structural, its bending springs flexion)");
   if (j.contains("stiffness")) per_kind(m.material.stiffness, j["stiffness"], where + ".stiffness", Range::positive);
   if (j.contains("damping")) per_kind(m.material.damping, j["damping"], where + ".damping", Range::non_negative);
   if (j.contains("pins")) {
@@ -387,7 +387,7 @@ void apply_drag(Scene& s, const json& j, const std::string& where) {
   }
   if (j.contains("stiffness") && !h.as_spring)
     bad_value(where + ".stiffness",
-                    "the spring mode's (\"mode\": \"spring\"); the hard mode puts the node on its path");
+              "the spring mode's (\"mode\": \"spring\"); the hard mode puts the node on its path");
   // Keys absent keep the scene's: a drag over a scene without one names both.
   if (d.node.kind == NodeSelector::Kind::index && d.node.index < 0)
     bad_value(where, "needs \"node\" (the scene has no drag node to keep)");

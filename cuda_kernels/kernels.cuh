@@ -104,7 +104,8 @@ __device__ __forceinline__ Vec3f gather_stencil(const StepParams& s, const Stenc
 template <int N, bool Damped>
 __device__ __forceinline__ Vec3f gather_grid(const StepParams& s, const Stencil& st, int i, int j, int k,
                                              const Vec3f& xi, const Vec3f& vi, const Window& w) {
-  if (P::grid_interior(s, i, j, k, N == kLatticeStencil)) return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
+  if (P::grid_interior(s, i, j, k, N == kLatticeStencil))
+    return gather_stencil<N, Damped, false>(s, st, i, j, k, xi, vi, w);
   return gather_stencil<N, Damped, true>(s, st, i, j, k, xi, vi, w);
 }
 

@@ -72,7 +72,8 @@ __global__ void __maxnreg__(kGatherRegisters)
   if (i < s.nx && j < s.ny) {
     const int node = P::grid_node(i, j, 0, s.nx, s.ny), at = (threadIdx.y + kHalo) * kTmaBoxW + threadIdx.x + kHalo;
     const float4 x4 = box[0][at], v4 = Damped ? box[1][at] : v[node];
-    const Vec3f a = grid_accel<kClothStencil, Damped>(s, st, i, j, 0, node, x4, v4, {box[0], box[1], at, kTmaBoxW, 0}, tg.force);
+    const Vec3f a = grid_accel<kClothStencil, Damped>(s, st, i, j, 0, node, x4, v4, {box[0], box[1], at, kTmaBoxW, 0},
+                                                      tg.force);
     d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
   }
   store_displacement(check, d);

@@ -237,7 +237,7 @@ void require_size_scenes(const Experiment& x, const Sweep& s, const std::string&
       resolve_params(scene, build_model(scene));
     } catch (const std::invalid_argument& e) {
       bad_value(where + ".sweep.sizes[" + std::to_string(k) + "]",
-                      "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
+                "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
     }
   }
 }

@@ -57,10 +57,10 @@ void add_box(const MeshShape& s) {
 // On more than one thread both make a slightly different mesh on every call (a 146 k-node sheet:
 // 146,333 to 146,388 nodes). On one a sheet is the same mesh each time; a box is not within one
 // process (Gmsh 4.8 hands HXT the boundary's nodes in the order of their addresses).
-// HXT leaves a flat tetrahedron, four nodes in a plane, which a model refuses, in many boxes of two
-// cells a side (within one process, 4 to 22 calls in 40 on 2 threads, 13 to 19 on one; none at 3 to 10
-// cells a side, nor in a 0.2 x 0.1 x 0.3 m box of 0.01 m cells): such a box is meshed again with
-// Gmsh's serial Delaunay (Mesh.Algorithm3D 1), which left none in those boxes.
+// HXT leaves a flat tetrahedron, four nodes in a plane, which a model refuses, in many boxes of
+// two cells a side (within one process, 4 to 22 calls in 40 on 2 threads, 13 to 19 on one; none
+// at 3 to 10 cells a side, nor in a 0.2 x 0.1 x 0.3 m box of 0.01 m cells): such a box is meshed
+// again with Gmsh's serial Delaunay (Mesh.Algorithm3D 1), which left none in those boxes.
 Mesh generate_shape(const MeshShape& s, const std::string& save_to) {
   GmshSession gmsh;
   Mesh m;
