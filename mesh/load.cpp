@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -72,22 +73,49 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   }
 };
 
+// Appends the vertices of `a` that its faces use to `position`, those at one position once, in
+// the order of their first index; returns the index in `position` of each of a's vertices.
+// (assimp's own aiProcess_JoinIdenticalVertices also joins vertices within about 1e-5 of a
+// file unit, which would turn a fine mesh's small triangles into degenerate ones.)
+std::vector<std::int32_t> join_identical_vertices(const aiMesh& a, std::vector<Vec3f>& position) {
+  std::vector<std::int32_t> vertex(a.mNumVertices, -1);
+  for (unsigned f = 0; f < a.mNumFaces; ++f)
+    for (unsigned i = 0; i < a.mFaces[f].mNumIndices; ++i) vertex[a.mFaces[f].mIndices[i]] = 0;
+  struct Bits {
+    std::size_t operator()(const std::array<std::uint32_t, 3>& b) const {
+      const std::uint64_t mixed = (std::uint64_t(b[0]) << 32 | b[1]) ^ (std::uint64_t(b[2]) * 0x9e3779b97f4a7c15u);
+      return std::hash<std::uint64_t>{}(mixed);
+    }
+  };
+  std::unordered_map<std::array<std::uint32_t, 3>, std::int32_t, Bits> first;
+  for (unsigned v = 0; v < a.mNumVertices; ++v) {
+    if (vertex[v] < 0) continue;
+    const Vec3f p{a.mVertices[v].x + 0.f, a.mVertices[v].y + 0.f, a.mVertices[v].z + 0.f};  // -0 is 0
+    const auto [at, fresh] = first.try_emplace(std::bit_cast<std::array<std::uint32_t, 3>>(p),
+                                               std::int32_t(position.size()));
+    if (fresh) position.push_back(p);
+    vertex[v] = at->second;
+  }
+  return vertex;
+}
+
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
   require_ply_header_end(path);
   Assimp::Importer importer;
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
-  // Positions only, so that joining identical vertices looks at positions alone.
+  // Positions only: the other components are dropped before the other steps.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS |
                                                           aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
                                                           aiComponent_TEXTURES | aiComponent_LIGHTS |
                                                           aiComponent_CAMERAS | aiComponent_MATERIALS);
-  importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);  // one mesh per object: duplicates across them are welded (and counted) below
-  // Read first, checked for coordinates that are not finite, then processed: joining identical
-  // vertices would otherwise merge a NaN vertex into another and hide it.
+  // One mesh per object: vertices shared across them are left for repair() to weld and count.
+  importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
+  // Read first and checked for coordinates that are not finite, those of vertices no face uses
+  // too, then processed.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
   if (!scene) refused_by_assimp(path, importer);
-  // Joining identical vertices also drops those no face uses, unseen: counted here.
+  // Vertices no face uses are left out below: counted here.
   std::int64_t unused = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
@@ -101,22 +129,20 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   }
   if (unused) notes.push_back("dropped " + std::to_string(unused) + " unreferenced vertices");
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
-                                       aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices |
-                                       aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+                                       aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                                       aiProcess_ValidateDataStructure);
   if (!scene) refused_by_assimp(path, importer);
   Mesh m;
   std::int64_t points = 0, lines = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
-    const auto base = std::int64_t(m.position.size());
-    if (base + a->mNumVertices > (std::int64_t(1) << 30)) bad(path, "more than 2^30 vertices");
-    for (unsigned v = 0; v < a->mNumVertices; ++v)
-      m.position.push_back({a->mVertices[v].x, a->mVertices[v].y, a->mVertices[v].z});
+    if (std::int64_t(m.position.size()) + a->mNumVertices > (std::int64_t(1) << 30))
+      bad(path, "more than 2^30 vertices");
+    const std::vector<std::int32_t> vertex = join_identical_vertices(*a, m.position);
     for (unsigned f = 0; f < a->mNumFaces; ++f) {
       const aiFace& face = a->mFaces[f];
       if (face.mNumIndices == 3)
-        m.triangle.push_back({std::int32_t(base + face.mIndices[0]), std::int32_t(base + face.mIndices[1]),
-                              std::int32_t(base + face.mIndices[2])});
+        m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});
       else if (face.mNumIndices == 2) ++lines;
       else ++points;
     }

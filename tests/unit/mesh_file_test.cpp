@@ -9,6 +9,7 @@
 #include <gmsh.h>
 #include <sys/stat.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -78,6 +79,27 @@ TEST_F(MeshFile, UnreferencedVerticesOfAPlyAreCounted) {
                                "9 9 9\n0 0 0\n1 0 0\n0 1 0\n5 5 5\n3 1 2 3\n"));
   EXPECT_EQ(m.position.size(), 3u);
   EXPECT_EQ(notes_, std::vector<std::string>{"dropped 2 unreferenced vertices"});
+}
+
+// An STL repeats each vertex per facet: those at one position (0 and -0 alike) are joined
+// without a repair, and vertices 5e-6 apart stay apart (assimp's own joining took them for one).
+TEST_F(MeshFile, StlVerticesJoinOnlyAtOnePosition) {
+  auto facet = [](const char* a, const char* b, const char* c) {
+    return std::string("facet normal 0 0 1\nouter loop\nvertex ") + a + "\nvertex " + b + "\nvertex " + c +
+           "\nendloop\nendfacet\n";
+  };
+  Mesh m = load(write("j.stl", "solid j\n" + facet("0 0 0", "1 0 0", "-0 1 0") + facet("1 0 0", "1 1 0", "0 1 0") +
+                                   "endsolid j\n"));
+  EXPECT_EQ(m.position.size(), 4u);
+  EXPECT_EQ(m.triangle.size(), 2u);
+  EXPECT_TRUE(notes_.empty());
+  EXPECT_TRUE(repair(m).empty());
+  EXPECT_EQ(m.position[2], (Vec3f{0, 1, 0}));
+  EXPECT_FALSE(std::signbit(m.position[2].x));
+
+  Mesh fine = load(write("f.stl", "solid f\n" + facet("0 0 1", "0.000005 0 1", "0 0.000005 1") + "endsolid f\n"));
+  EXPECT_EQ(fine.position.size(), 3u);
+  EXPECT_TRUE(repair(fine).empty());
 }
 
 TEST_F(MeshFile, PlyStlAndGltfGiveTheObjsMesh) {
