@@ -160,7 +160,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     const Slot& s = slots_[0];
     const auto& a = acc_[0];
     for_nodes([&](int i) {
-      P::one_pass_update(int(sched_.rule), Real(1), s.x[i], s.v[i], a[i], x_prev_[i], has_prev_, sp_.dt,
+      P::one_pass_update(int(sched_.rule), Real(1), s.x[i], s.v[i], a[i], has_prev_, sp_.dt,
                          next_.x[i], next_.v[i]);
     });
   }

@@ -66,7 +66,7 @@ const std::vector<IntegratorInfo>& integrators() {
       entry(Integrator::rk4, "rk4", "", R::runge_kutta, classic4(), 4,
        "classical Runge-Kutta, four force evaluations (not the paper's eqs. 10-11)"),
       entry(Integrator::verlet, "verlet", "midpoint-verlet", R::verlet, Tableau{}, 2,
-       "position Verlet (the paper's eq. 6; its eq. 9 is not a known scheme)"),
+       "Verlet (the paper's eq. 6; its eq. 9 is not a known scheme) as a leapfrog; first order with damping"),
       entry(Integrator::backward_euler, "backward-euler", "", R::backward_euler, Tableau{}, 1,
        "implicit Euler, linearised, sparse conjugate gradient (Baraff & Witkin)"),
   };

@@ -17,7 +17,7 @@ enum class Integrator {
   midpoint,             // RK2: a at the half-step state (two force passes)
   rk3,                  // Kutta's third-order Runge-Kutta (three force passes)
   rk4,                  // classical Runge-Kutta 4 (four force passes)
-  verlet,               // position Verlet: x' = 2x - x_prev + dt^2 a,  v' = (x' - x) / dt
+  verlet,               // Verlet as a leapfrog: v' = v + dt a, x' = x + dt v' (v at half steps)
   backward_euler,       // implicit Euler, one linearised solve per step (Baraff & Witkin 1998)
 };
 

@@ -24,7 +24,7 @@
 // Update rules (Schedule::rule): how a step's result is formed from its force passes.
 #define RULE_RUNGE_KUTTA 0         // s0 + dt sum_j b_j k_j, slopes k_j = (v_j, a_j)
 #define RULE_SEMI_IMPLICIT_EULER 1 // v' = v + dt a, x' = x + dt v'
-#define RULE_VERLET 2              // x' = 2x - x_prev + dt^2 a, v' = (x' - x) / dt
+#define RULE_VERLET 2              // leapfrog: as above, v at half steps (the first kick dt/2)
 
 #define ZERO3 VEC3(real(0), real(0), real(0))
 #define MAX_SPHERES 8
@@ -132,17 +132,16 @@ DL_FN void rk_state(vec3 x0, vec3 v0, vec3 dx, vec3 dv, real dt, OUT(vec3) x, OU
 }
 
 // The result of a schedule with one force pass: rule RULE_*, weight b_0 of a one-stage
-// Runge-Kutta scheme (explicit Euler), x_prev and has_prev for Verlet. Position Verlet with
-// no previous position starts with the Taylor step x + dt v + dt^2/2 a.
-DL_FN void one_pass_update(int rule, real weight, vec3 x, vec3 v, vec3 a, vec3 x_prev, bool has_prev, real dt,
-                           OUT(vec3) xo, OUT(vec3) vo) {
-  if (rule == RULE_SEMI_IMPLICIT_EULER) {
-    vo = v + a * dt;
+// Runge-Kutta scheme (explicit Euler). Verlet in its leapfrog form: v is the velocity of the
+// half step before (x' - x = dt v'), kicked by a whole step, and at the start (half_step false,
+// v the velocity at t) by half a step: x' = x + dt v + dt^2/2 a. Position Verlet's
+// x' = 2x - x_prev + dt^2 a is the same scheme, but takes a contact's projection of x for a
+// velocity; the leapfrog keeps the velocity the contact left.
+DL_FN void one_pass_update(int rule, real weight, vec3 x, vec3 v, vec3 a, bool half_step, real dt, OUT(vec3) xo,
+                           OUT(vec3) vo) {
+  if (rule == RULE_SEMI_IMPLICIT_EULER || rule == RULE_VERLET) {
+    vo = v + a * (rule == RULE_VERLET && !half_step ? real(0.5) * dt : dt);
     xo = x + vo * dt;
-  } else if (rule == RULE_VERLET) {
-    vec3 s = has_prev ? (x - x_prev) + a * (dt * dt) : v * dt + a * (real(0.5) * dt * dt);
-    xo = x + s;
-    vo = s * DL_RECIP(dt);
   } else {
     vec3 dx = ZERO3, dv = ZERO3;
     add_slope(dx, dv, weight, v, a);

@@ -131,9 +131,8 @@ __device__ __forceinline__ float advance_node(const StepParams& s, float weight,
                                               const float4& v4, const Vec3f& a, const float4* x_prev, bool has_prev,
                                               const Vec3f& end_target, float4* xo, float4* vo) {
   const Vec3f x = xyz(x4);
-  const Vec3f xp = (Rule == RULE_VERLET && has_prev) ? xyz(x_prev[i]) : Vec3f{};
   Vec3f xn, vn;
-  P::one_pass_update(Rule, weight, x, xyz(v4), a, xp, has_prev, s.dt, xn, vn);
+  P::one_pass_update(Rule, weight, x, xyz(v4), a, has_prev, s.dt, xn, vn);
   P::constrain_node(s, i, x4.w, x, end_target, xn, vn);
   xo[i] = f4(xn, x4.w);
   vo[i] = f4(vn, 0.f);

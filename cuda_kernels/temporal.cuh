@@ -126,9 +126,8 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
       const Vec3f xi = xyz(x4), vi = xyz(v4);
       const Window w{sx(cur), sv(cur), l, r.cells.x, r.cells.x * r.cells.y};
       const Vec3f acc = grid_accel<N, Damped>(s, st, i, j, k, node, x4, v4, w, tg.step[q].force);
-      const Vec3f xp = kVerlet && prev ? xyz(sx(1 - cur)[l]) : Vec3f{};
       Vec3f xn, vn;
-      P::one_pass_update(Rule, weight, xi, vi, acc, xp, prev, s.dt, xn, vn);
+      P::one_pass_update(Rule, weight, xi, vi, acc, prev, s.dt, xn, vn);
       P::constrain_node(s, node, x4.w, xi, tg.step[q].end, xn, vn);
       sx(1 - cur)[l] = f4(xn, x4.w);
       sv(1 - cur)[l] = f4(vn, 0.f);

@@ -134,7 +134,7 @@ void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out v
   vec3 x, v;
   o2 = vec4(0.0);
 #if PASS == PASS_ONE
-  one_pass_update(RULE, u_weights[0], x0.xyz, v0.xyz, a, xp.xyz, u_has_prev, dt, x, v);
+  one_pass_update(RULE, u_weights[0], x0.xyz, v0.xyz, a, u_has_prev, dt, x, v);
   o2 = x0;
 #else
   vec3 dx = vec3(0.0), dv = vec3(0.0);
