@@ -45,14 +45,19 @@ std::string extension_of(const std::string& path) {
 }
 
 // assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
-// file is refused first (the header is text, within its first 64 KiB in any file we know).
-void require_ply_header_end(const std::string& path) {
-  if (extension_of(path) != ".ply") return;
+// file is refused first (the header is text, within its first 64 KiB in any file we know). A
+// file is read as PLY by its extension or, where assimp knows no reader for its extension,
+// when "ply" is in its first 200 bytes (assimp's own test).
+void require_ply_header_end(const std::string& path, const Assimp::Importer& importer) {
   std::ifstream in(path, std::ios::binary);
   std::string head(64 * 1024, '\0');
   in.read(head.data(), std::streamsize(head.size()));
   head.resize(std::size_t(in.gcount()));
-  if (head.find("end_header") == std::string::npos)
+  const std::string ext = extension_of(path);
+  std::string start = head.substr(0, 200);
+  for (char& c : start) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && start.find("ply") != std::string::npos);
+  if (ply && head.find("end_header") == std::string::npos)
     bad(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
 
@@ -100,8 +105,8 @@ std::vector<std::int32_t> join_identical_vertices(const aiMesh& a, std::vector<V
 }
 
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
-  require_ply_header_end(path);
   Assimp::Importer importer;
+  require_ply_header_end(path, importer);
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
   // Positions only: the other components are dropped before the other steps.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
@@ -136,15 +141,16 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   std::int64_t points = 0, lines = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
+    if (!(a->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {  // points or lines (SortByPType): no nodes
+      for (unsigned f = 0; f < a->mNumFaces; ++f) ++(a->mFaces[f].mNumIndices == 2 ? lines : points);
+      continue;
+    }
     if (std::int64_t(m.position.size()) + a->mNumVertices > (std::int64_t(1) << 30))
       bad(path, "more than 2^30 vertices");
     const std::vector<std::int32_t> vertex = join_identical_vertices(*a, m.position);
     for (unsigned f = 0; f < a->mNumFaces; ++f) {
       const aiFace& face = a->mFaces[f];
-      if (face.mNumIndices == 3)
-        m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});
-      else if (face.mNumIndices == 2) ++lines;
-      else ++points;
+      m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});
     }
   }
   if (points || lines)

@@ -289,6 +289,9 @@ const std::vector<BadInput>& cases() {
            "m.ply"),
       mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            "ply\nformat ascii 1.0\n", "m.ply"),
+      // Read as PLY for its content where assimp knows no reader for its extension.
+      mesh("mesh_ply_truncated_header_unnamed", "{\"file\": \"m.dat\"}",
+           "m.dat': its PLY header has no end_header line", "ply\nformat ascii 1.0\nelement vertex 3\nprop", "m.dat"),
       // assimp 5.2 crashes on this header (a property line run into end_header), and takes a
       // count as it stands: read in a child process, either is one line naming the file
       // (tests/unit/child_read_test.cpp checks the lines a crash and the memory cap give).

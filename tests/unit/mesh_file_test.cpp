@@ -102,6 +102,15 @@ TEST_F(MeshFile, StlVerticesJoinOnlyAtOnePosition) {
   EXPECT_TRUE(repair(fine).empty());
 }
 
+// A line left out does not add its vertices: nodes keep the order in which faces use them.
+TEST_F(MeshFile, ALineLeftOutAddsNoNodes) {
+  Mesh m = load(write("l.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 2 2\nf 1 2 3\nl 3 4\n"));
+  EXPECT_EQ(m.position.size(), 3u);
+  EXPECT_EQ(m.position[0], (Vec3f{0, 0, 0}));
+  EXPECT_EQ(notes_, std::vector<std::string>{"left out 0 points and 1 lines"});
+  EXPECT_TRUE(repair(m).empty());
+}
+
 TEST_F(MeshFile, PlyStlAndGltfGiveTheObjsMesh) {
   // The same closed surface (a tetrahedron) exported by assimp in each format, read back.
   const std::string obj = write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
