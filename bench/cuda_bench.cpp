@@ -89,9 +89,9 @@ class Report {
   ClockTally& clocks() { return clocks_; }
 
   // The bare gather (cuda::time_bare_gather) of the scene's springs (their neighbours' velocities
-  // read where any kind is damped, as cuda-fused reads them) for one-step integrators (64 B a
-  // node) or Verlet (80), on cuda-fused's block, with its per-thread loads of fast math.
-  Row bare_gather(SceneKind kind, const BenchScene& scene, bool verlet, const CudaOptions& o) {
+  // read where any kind is damped, as cuda-fused reads them) for the one-step integrators (64 B a
+  // node), on cuda-fused's block, with its per-thread loads of fast math.
+  Row bare_gather(SceneKind kind, const BenchScene& scene, const CudaOptions& o) {
     const Model& m = scene.model;
     const bool damped = m.damped();
     const int n = m.nx;
@@ -101,15 +101,15 @@ class Report {
     r.scene = to_string(kind);
     r.grid = std::to_string(n) + "^2";
     r.variant = "bare-gather";
-    r.integrator = verlet ? "verlet" : "euler";
+    r.integrator = "one-step";
     r.tile = cuda::to_string(tile);
     r.math = "none";
     r.graphs = false;
     r.nodes = std::int64_t(n) * n;
-    const TimedWork w = cuda::time_bare_gather(n, tile, damped, verlet, o.warmup_ms);
+    const TimedWork w = cuda::time_bare_gather(n, tile, damped, o.warmup_ms);
     r.ms = w.median_ms();
     r.clock = w.clock;
-    r.floor_bytes = verlet ? 80 : 64;
+    r.floor_bytes = 64;
     clocks_.add("bare gather " + r.grid + " " + r.scene + " " + r.integrator, w.clock);
     return record(r, 1);
   }
@@ -225,22 +225,19 @@ void run_cuda(const CudaOptions& o) {
               << "^2 without its arithmetic (block " << fused_block() << ", cuda-fused's; in exact math it loads "
               << "cloths through the tensor memory accelerator instead): "
               << "each node's x and v and its 12 "
-              << "neighbours' x, and their v where springs are damped (the paper scene), Verlet's previous x; "
+              << "neighbours' x, and their v where springs are damped (the paper scene); "
               << "the fastest of 1, 2 or 4 neighbours' loads at a time, each timed as the steps are (after "
               << (o.warmup_ms > 0 ? fixed(o.warmup_ms, 0) + " ms of launches and " : "") << cuda::kReferenceWarmUp
               << " warm-up launches); a reference, not a bound "
               << "(cuda-fused's L2 prefetch can beat it)\n"
               << std::setw(12) << "scene" << std::setw(22) << "integrator" << std::setw(12) << "ms/step"
               << std::setw(10) << "B/node" << std::setw(10) << "of copy" << "\n";
-    std::map<std::pair<SceneKind, bool>, double> bare_ms;
+    std::map<SceneKind, double> bare_ms;
     for (SceneKind k : {SceneKind::paper, SceneKind::idealised}) {
-      const BenchScene scene(o.tile_size, k);
-      for (bool verlet : {false, true}) {
-        const Row r = rep.bare_gather(k, scene, verlet, o);
-        bare_ms[{k, verlet}] = r.ms;
-        std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4)
-                  << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%\n";
-      }
+      const Row r = rep.bare_gather(k, BenchScene(o.tile_size, k), o);
+      bare_ms[k] = r.ms;
+      std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(12) << fixed(r.ms, 4)
+                << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(9) << fixed(100 * r.of_copy, 1) << "%\n";
     }
 
     std::cout << "\n[fused] one-pass integrators at " << o.tile_size << "^2 in exact and fast math against the copy "
@@ -255,7 +252,7 @@ void run_cuda(const CudaOptions& o) {
         for (Math math : {Math::exact, Math::fast}) {
           const BenchScene scene(o.tile_size, k);
           const Row r = rep.measure("fused", k, scene, i, {cuda::Variant::fused, {}, true, math}, o);
-          const double bare = bare_ms.at({k, i == Integrator::verlet});
+          const double bare = bare_ms.at(k);
           std::cout << std::setw(12) << r.scene << std::setw(22) << r.integrator << std::setw(7) << r.math
                     << std::setw(12) << fixed(r.ms, 4) << std::setw(10) << fixed(r.floor_bytes, 0) << std::setw(9)
                     << fixed(100 * r.of_copy, 1) << "%" << std::setw(9) << fixed(100 * bare / r.ms, 1) << "%";

@@ -103,17 +103,17 @@ Stats time_passthrough(int n, const StepOptions& o) {
 }
 
 // glsl-compute's bare gather (shaders/bare_gather.comp) on an n x n cloth: step.comp's loads
-// and stores for a one-pass integrator (Verlet: with the previous positions), ping-pong; its
-// buffers where glsl-compute's node buffers are (the memory option's default here).
-Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
+// and stores for a one-pass integrator, ping-pong; its buffers where glsl-compute's node
+// buffers are (the memory option's default here).
+Stats time_bare_gather(int n, const StepOptions& o) {
   using namespace gl;
-  const std::string defines = compute_tile_defines() + stencil_defines(false) + (verlet ? "#define PREVIOUS 1\n" : "");
+  const std::string defines = compute_tile_defines() + stencil_defines(false);
   Program prog = make_program({{GL_COMPUTE_SHADER, "bare_gather.comp"}}, defines);
   std::unique_ptr<NodeMemory> memory = default_memory();
-  GLuint buf[2][3];
+  GLuint buf[2][2];
   const float half = 0.5f;
   for (int c = 0; c < 2; ++c)
-    for (int a = 0; a < 3; ++a) {
+    for (int a = 0; a < 2; ++a) {
       buf[c][a] = memory->add(std::size_t(n) * n * 16);
       glClearNamedBufferData(buf[c][a], GL_R32F, GL_RED, GL_FLOAT, &half);
     }
@@ -122,9 +122,9 @@ Stats time_bare_gather(int n, bool verlet, const StepOptions& o) {
   int k = 0;
   const auto bind = [&] {
     const int c = k++ % 2;
-    for (GLuint a = 0; a < 3; ++a) {
+    for (GLuint a = 0; a < 2; ++a) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, a, buf[c][a]);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + a, buf[1 - c][a]);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2 + a, buf[1 - c][a]);
     }
   };
   const auto dispatch = [&] {
@@ -179,7 +179,7 @@ void run_gl(const StepOptions& o) {
     const Model& m = scene.model;
     const PipelineSetup setup = scene.setup(integ);
     const Stats ceiling = time_passthrough(m.node_count(), o),
-                bare = time_bare_gather(n, integ == Integrator::verlet, o);
+                bare = time_bare_gather(n, o);
     Stats tf, compute, compute_fast;
     std::string neighbours;
     {

@@ -38,19 +38,16 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     for (auto& sl : slots_) { sl.x.resize(n); sl.v.resize(n); }
     acc_.resize(sched_.accel_slots, std::vector<V>(n));
     next_.x.resize(n); next_.v.resize(n);
-    x_prev_.resize(n);
     set_state(rest_state(m_));
   }
 
   void set_state(const State& s) override {
     const std::size_t n = m_.rest_position.size();
-    if (s.x.size() != n || s.v.size() != n || (!s.x_prev.empty() && s.x_prev.size() != n))
-      throw std::invalid_argument("state size does not match the model");
-    has_prev_ = !s.x_prev.empty();
+    if (s.x.size() != n || s.v.size() != n) throw std::invalid_argument("state size does not match the model");
+    half_step_ = s.half_step;
     for_nodes([&](int i) {
       slots_[0].x[i] = V(s.x[i]);
       slots_[0].v[i] = V(s.v[i]);
-      if (has_prev_) x_prev_[i] = V(s.x_prev[i]);
     });
     t_ = s.t;
     last_disp_ = 0.0;
@@ -60,12 +57,11 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     State s;
     s.t = t_;
     const std::size_t n = slots_[0].x.size();
+    s.half_step = half_step_;
     s.x.resize(n); s.v.resize(n);
-    if (has_prev_) s.x_prev.resize(n);
     for_nodes([&](int i) {
       s.x[i] = Vec3f(slots_[0].x[i]);
       s.v[i] = Vec3f(slots_[0].v[i]);
-      if (has_prev_) s.x_prev[i] = Vec3f(x_prev_[i]);
     });
     return s;
   }
@@ -160,7 +156,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
     const Slot& s = slots_[0];
     const auto& a = acc_[0];
     for_nodes([&](int i) {
-      P::one_pass_update(int(sched_.rule), Real(1), s.x[i], s.v[i], a[i], has_prev_, sp_.dt,
+      P::one_pass_update(int(sched_.rule), Real(1), s.x[i], s.v[i], a[i], half_step_, sp_.dt,
                          next_.x[i], next_.v[i]);
     });
   }
@@ -263,10 +259,7 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
       P::constrain_node(sp_, i, Real(m_.inv_mass[i]), s.x[i], drag_target, next_.x[i], next_.v[i]);
       disp = std::max(disp, P::displacement(next_.x[i], s.x[i], next_.v[i]));
     }
-    if (sched_.rule == UpdateRule::verlet) {
-      x_prev_.swap(s.x);  // the old current positions become the previous ones
-      has_prev_ = true;
-    }
+    if (sched_.rule == UpdateRule::verlet) half_step_ = true;
     std::swap(s.x, next_.x);
     std::swap(s.v, next_.v);
     t_ = t1;
@@ -282,9 +275,8 @@ class CpuPipeline final : public Pipeline, private ForceStage, private UpdateSta
   std::vector<Slot> slots_;  // 0: current state, 1..: stage states
   std::vector<std::vector<V>> acc_;
   Slot next_;
-  std::vector<V> x_prev_;
   Profiler* prof_ = nullptr;
-  bool has_prev_ = false;
+  bool half_step_ = false;
   double t_ = 0.0;
   double last_disp_ = 0.0;
 };
@@ -303,8 +295,8 @@ std::vector<Vec3f> cpu_accelerations(const PipelineSetup& setup, const State& s,
 static Footprint cpu_footprint(const ModelSize& m, Integrator i, Precision p) {
   const Schedule s = make_schedule(i);
   const std::int64_t real = p == Precision::f64 ? 8 : 4, vec = 3 * real;
-  // slots (x, v), accelerations, the next state and Verlet's previous positions
-  Footprint f{m.nodes * vec * (2 * (1 + s.stage_states) + s.accel_slots + 3), 0};
+  // slots (x, v), accelerations and the next state
+  Footprint f{m.nodes * vec * (2 * (1 + s.stage_states) + s.accel_slots + 2), 0};
   if (s.rule == UpdateRule::backward_euler) {
     // 3x3 blocks: triplets (two indices and a value), the matrix and its transposed copy while
     // assembled; per node the diagonal blocks, K v0, and the solver's vectors (about 8 x 3n).

@@ -14,7 +14,7 @@ std::int64_t model_host_bytes(const ModelSize& s) {
   return nodes + s.springs * (4 + 4 + 4 + 1 + 4 + 4) + (s.nodes + 1) * 4 + 2 * s.springs * (4 + 4);
 }
 
-std::int64_t state_host_bytes(std::int64_t nodes) { return nodes * 3 * 12; }
+std::int64_t state_host_bytes(std::int64_t nodes) { return nodes * 2 * 12; }
 
 namespace {
 

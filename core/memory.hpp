@@ -16,7 +16,7 @@ struct ModelSize {
 
 // Host bytes of the Model itself (Model::host_bytes() of the built one).
 std::int64_t model_host_bytes(const ModelSize& s);
-// Host bytes of a State of this many nodes (x, v and Verlet's x_prev).
+// Host bytes of a State of this many nodes (x and v).
 std::int64_t state_host_bytes(std::int64_t nodes);
 
 // What a pipeline allocates beyond the model: host memory and memory on its device.

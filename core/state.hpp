@@ -12,13 +12,13 @@ struct Model;
 struct State {
   std::vector<Vec3f> x;       // [n] positions, m
   std::vector<Vec3f> v;       // [n] velocities, m/s
-  // [n] previous positions, kept by Verlet. Empty means "start from (x, v)": Verlet's
-  // first step is then the Taylor start x1 = x + dt v + dt^2/2 a, second-order accurate.
-  std::vector<Vec3f> x_prev;
   double t = 0.0;             // simulated time, s
+  // Verlet: v is the velocity of the half step before t (set by its steps). False: v is at t,
+  // and Verlet's next step kicks by half a step (x1 = x + dt v + dt^2/2 a).
+  bool half_step = false;
 };
 
-// The model at rest: x = rest positions, v = 0, no x_prev, t = 0.
+// The model at rest: x = rest positions, v = 0, t = 0.
 State rest_state(const Model& m);
 
 }  // namespace deformlab

@@ -44,12 +44,11 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
       temporal_ = true;
       plan_ = plan_temporal(m, o_);
     }
-    sets_ = state_sets(su.integrator, o_.variant);
     if (dev::kPrefetchAhead && fused_ && m.grid()) plan_prefetch();
 
     check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "creating the pipeline's stream");
 
-    for (int c = 0; c < sets_; ++c) {
+    for (int c = 0; c < kStateSets; ++c) {
       x_[c].allocate(n_, "allocating positions");
       v_[c].allocate(n_, "allocating velocities");
     }
@@ -59,18 +58,16 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     }
     if (!fused_ && !temporal_)
       for (int k = 0; k < sched_.accel_slots; ++k) acc_[k].allocate(n_, "allocating accelerations");
-    if (temporal_ && sched_.rule == UpdateRule::verlet)
-      for (auto& b : prev_) b.allocate(n_, "allocating previous positions");
     if (tma_misfit(o_, m, su.integrator).empty()) {
       tma_ = device_info().cc_major >= 9 && o_.tma.value_or(o_.math == Math::exact);
       if (!o_.tma && o_.math == Math::exact) chosen_["tma"] = tma_ ? "on" : "off";
     }
-    for (int c = 0; tma_ && c < sets_; ++c) {
+    for (int c = 0; tma_ && c < kStateSets; ++c) {
       tma_maps_[c][0] = cloth_tensor_map(x_[c].get(), m.nx, m.ny);
       if (damped_) tma_maps_[c][1] = cloth_tensor_map(v_[c].get(), m.nx, m.ny);
     }
-    stop_.allocate(sets_ + 1, "allocating the stop rule's reduction");
-    check(cudaMemsetAsync(stop_.get(), 0, (sets_ + 1) * sizeof(unsigned), stream_),
+    stop_.allocate(kStateSets + 1, "allocating the stop rule's reduction");
+    check(cudaMemsetAsync(stop_.get(), 0, (kStateSets + 1) * sizeof(unsigned), stream_),
           "clearing the stop rule's reduction");
     void* h = nullptr;
     check(cudaHostAlloc(&h, sizeof(unsigned long long), cudaHostAllocMapped), "allocating the displacement read-back");
@@ -88,17 +85,15 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   void set_state(const State& s) override {
-    if (s.x.size() != std::size_t(n_) || s.v.size() != std::size_t(n_) ||
-        (!s.x_prev.empty() && s.x_prev.size() != std::size_t(n_)))
+    if (s.x.size() != std::size_t(n_) || s.v.size() != std::size_t(n_))
       throw std::invalid_argument("state size does not match the model");
     cur_ = 0;
     pending_ = 0;
     queued_ = Read::none;
-    check(cudaMemsetAsync(stop_.get(), 0, sets_ * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
+    check(cudaMemsetAsync(stop_.get(), 0, kStateSets * sizeof(unsigned), stream_), "clearing the stop rule's reduction");
     upload_positions(x_[0], s.x);
     upload_vectors(v_[0], s.v);
-    has_prev_ = !s.x_prev.empty();
-    if (has_prev_) upload_positions(prev_x(0), s.x_prev);
+    half_step_ = s.half_step;
     t_ = s.t;
     stepped_ = false;
     back_ = Back::none;
@@ -110,7 +105,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     s.t = t_;
     s.x = download(x_[cur_]);
     s.v = download(v_[cur_]);
-    if (sched_.rule == UpdateRule::verlet && has_prev_) s.x_prev = download(prev_x(cur_));
+    s.half_step = half_step_;
     return s;
   }
 
@@ -135,7 +130,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     if (temporal_) return hold_step();
     // Steps the profiler samples run pass by pass (a graph replay has no spans).
     const bool replay = !sampling(prof_) && o_.graphs && time_invariant() &&
-                        !(sched_.rule == UpdateRule::verlet && !has_prev_);
+                        !(sched_.rule == UpdateRule::verlet && !half_step_);
     if (replay) {
       if (!graph_[cur_]) capture(cur_);
       check(cudaGraphLaunch(graph_[cur_], stream_), "launching the step graph");
@@ -151,24 +146,23 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // the one before it what step_back returns to.
   void end_launch(int steps, double t_before) {
     back_t_ = t_before;
-    back_has_prev_ = has_prev_;
+    back_half_step_ = half_step_;
     back_ = Back::possible;
-    if (sched_.rule == UpdateRule::verlet) has_prev_ = true;
+    if (sched_.rule == UpdateRule::verlet) half_step_ = true;
     cur_ = after(cur_);
     launched_ += steps;
     ++result_launches_;
   }
 
-  // The kernels read state cur_ and write the next set, so the state before the last launch
-  // stays until the next (one-step Verlet reads the positions before it from a third set;
-  // cuda-temporal keeps them in prev_).
+  // The kernels read state cur_ and write the other set, so the state before the last launch
+  // stays until the next.
   bool can_step_back() const override { return true; }
   int steps_per_launch() const override { return temporal_ ? plan_.k : 1; }
   void step_back() override {
     if (back_ != Back::possible) throw std::logic_error("cuda pipeline: no launch to take back");
     cur_ = before(cur_);
     t_ = back_t_;
-    has_prev_ = back_has_prev_;
+    half_step_ = back_half_step_;
     back_ = Back::taken;
     // The launch taken back added into the word the next launch from this state adds into.
     check(cudaMemsetAsync(stop_.get() + cur_, 0, sizeof(unsigned), stream_), "clearing the stop rule's reduction");
@@ -385,27 +379,27 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   void one_pass_as(bool fused) {
     const int nxt = after(cur_);
     const float w = float(sched_.weight());
-    const float4 *x = x_[cur_].get(), *v = v_[cur_].get(), *xp = prev_x(cur_).get();
+    const float4 *x = x_[cur_].get(), *v = v_[cur_].get();
     float4 *xo = x_[nxt].get(), *vo = v_[nxt].get();
     const Targets tg = targets();
     if (!fused) {
-      dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), xp, has_prev_, xo, vo,
+      dev::update<Rule><<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, x, v, acc_[0].get(), half_step_, xo, vo,
                                                                 tg.end, stop_check());
       check_launch("launching the update kernel");
     } else if (!model_.grid()) {
       const auto kernel = damped_ ? dev::fused_csr<Rule, true> : dev::fused_csr<Rule, false>;
-      kernel<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, xp, has_prev_, xo, vo,
+      kernel<<<blocks_for(n_), kBlock, 0, stream_>>>(sp_, w, offset_.get(), links_.get(), x, v, half_step_, xo, vo,
                                                      tg, stop_check());
       check_launch("launching the fused CSR step kernel");
     } else if (tma_) {
       const auto kernel = damped_ ? dev::fused_cloth_tma<true, Rule> : dev::fused_cloth_tma<false, Rule>;
       kernel<<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, tma_maps_[cur_][0], tma_maps_[cur_][1], v,
-                                                            xp, has_prev_, xo, vo, tg, stop_check());
+                                                            half_step_, xo, vo, tg, stop_check());
       check_launch("launching the fused cloth step kernel");
     } else {
       with_grid_flags([&](auto n, auto damped) {
         dev::fused_grid<n(), damped(), Rule>
-            <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, xp, has_prev_, xo, vo, tg,
+            <<<grid_blocks(), grid_threads(), 0, stream_>>>(sp_, stencil_, w, x, v, half_step_, xo, vo, tg,
                                                             stop_check(), prefetch_);
       });
       check_launch("launching the fused step kernel");
@@ -428,12 +422,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   }
 
   // The state sets after and before set c.
-  int after(int c) const { return (c + 1) % sets_; }
-  int before(int c) const { return (c + sets_ - 1) % sets_; }
-  // Verlet's previous positions of state c: the positions of the set before it, or
-  // (cuda-temporal, whose launches read a tile's halo from them while others write) a pair of
-  // their own.
-  Buffer<float4>& prev_x(int c) { return temporal_ && sched_.rule == UpdateRule::verlet ? prev_[c] : x_[before(c)]; }
+  int after(int c) const { return (c + 1) % kStateSets; }
+  int before(int c) const { return (c + kStateSets - 1) % kStateSets; }
 
   // cuda-temporal's step: held until steps_per_launch steps can go in one launch.
   void hold_step() {
@@ -456,7 +446,6 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
     for (int q = 0; q < pending_ && p_.drag.active(); ++q)
       tg.step[q] = {p_.drag.target(held_t_[q]), p_.drag.target(held_t_[q] + p_.dt)};
     const int nxt = after(cur_);
-    const bool verlet = Rule == RULE_VERLET;
     const dim3 blocks = plan_.blocks(sp_.nx, sp_.ny, sp_.nz), threads(dev::kTemporalThreads);
     with_grid_flags([&](auto n, auto damped) {
       const auto kernel = dev::temporal_grid<n(), damped(), Rule>;
@@ -467,9 +456,8 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
               "raising the temporal kernel's shared-memory limit");
       temporal_limit_raised_ = true;
       kernel<<<blocks, threads, plan_.shared, stream_>>>(
-          sp_, stencil_, float(sched_.weight()), pending_, plan_.tile, x_[cur_].get(), v_[cur_].get(),
-          verlet ? prev_[cur_].get() : nullptr, has_prev_, x_[nxt].get(), v_[nxt].get(),
-          verlet ? prev_[nxt].get() : nullptr, tg, stop_check());
+          sp_, stencil_, float(sched_.weight()), pending_, plan_.tile, x_[cur_].get(), v_[cur_].get(), half_step_,
+          x_[nxt].get(), v_[nxt].get(), tg, stop_check());
     });
     check_launch("launching the temporal step kernel");
   }
@@ -478,7 +466,7 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   // adds into word c and passes on the word of the launch before it (the step graphs hold one
   // set each); the word after the sets' counts the launches.
   dev::StopCheck stop_check() {
-    return {stop_.get() + cur_, stop_.get() + before(cur_), stop_.get() + sets_, disp_device_};
+    return {stop_.get() + cur_, stop_.get() + before(cur_), stop_.get() + kStateSets, disp_device_};
   }
 
   // A stage state or the step's result from the slopes with a non-zero weight.
@@ -508,13 +496,10 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
   int n_ = 0;
   bool fused_ = false;
 
-  // State sets in turn: cur_ is the current state, the set before it the previous step's
-  // until the next step. Three with the one-step Verlet kernels, which read the positions
-  // before the current ones, else two.
-  Buffer<float4> x_[3], v_[3];
-  int sets_ = 2;
+  // State sets in turn: cur_ is the current state, the other the previous step's until the
+  // next step.
+  Buffer<float4> x_[kStateSets], v_[kStateSets];
   Buffer<float4> sx_[3], sv_[3], acc_[4];
-  Buffer<float4> prev_[2];  // cuda-temporal, Verlet: previous positions, read from cur_ and written to the other
   Buffer<unsigned> stop_;  // the maximum of a launch from each state, the result launches (stop_check)
   struct FreeHost {
     void operator()(void* p) const { cudaFreeHost(p); }
@@ -528,18 +513,18 @@ class Impl final : public CudaPipeline, private ForceKernels, private ForceStage
 
   cudaStream_t stream_ = nullptr;
   cudaEvent_t copied_ = nullptr;  // copy_positions: the steps before a copy
-  cudaGraphExec_t graph_[3] = {};  // one step from each state set
+  cudaGraphExec_t graph_[kStateSets] = {};  // one step from each state set
   int cur_ = 0;
   int prefetch_ = 0;  // fused grid launches with dev::kPrefetchAhead: plan_prefetch
   // Fused cloth launches by dev::fused_cloth_tma, each set's x (and v if damped) through its tensor maps.
   bool tma_ = false;
-  std::array<CUtensorMap, 2> tma_maps_[3] = {};
+  std::array<CUtensorMap, 2> tma_maps_[kStateSets] = {};
   std::map<std::string, std::string> chosen_;  // chosen_options
-  bool has_prev_ = false, stepped_ = false;
+  bool half_step_ = false, stepped_ = false;
   double t_ = 0.0;
   enum class Back { none, possible, taken } back_ = Back::none;  // step_back
   double back_t_ = 0.0;         // t_ before the last launch
-  bool back_has_prev_ = false;  // has_prev_ before it
+  bool back_half_step_ = false;  // half_step_ before it
   std::int64_t launched_ = 0;  // steps queued on the device
 
   // cuda-temporal: steps are held back until a launch can take steps_per_launch of them (or

@@ -100,10 +100,8 @@ std::string unsupported(Integrator i, Variant v);
 // Device bytes of a general model's springs as variant v reads them (the CSR adjacency, or
 // the scatter's spring list); 0 for grids, whose springs are the stencil.
 std::int64_t spring_bytes(const ModelSize& m, Variant v);
-// The (x, v) state sets a pipeline cycles through: three for the one-step Verlet kernels, whose
-// step reads the previous positions from the set before, else two (cuda-temporal keeps Verlet's
-// previous positions apart).
-int state_sets(Integrator i, Variant v);
+// The (x, v) state sets a pipeline cycles through: a launch reads one and writes the other.
+inline constexpr int kStateSets = 2;
 // Device memory a pipeline needs, bytes (state, stage slots, model arrays).
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o);
 // Device memory the pipelines' buffers hold now, bytes: what bytes_needed is tested against.
@@ -133,11 +131,11 @@ inline constexpr int kReferenceWarmUp = 10;
 // A device-to-device cudaMemcpy of `bytes`, `min_reps` at the least.
 TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms);
 // The bare gather: cuda-fused's loads and stores on an n x n cloth without its arithmetic
-// (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs); the
-// previous positions with `previous` (Verlet)), on blocks of `tile`: the fastest of three load
+// (a node's x and v and its 12 neighbours' x, and v with `velocities` (damped springs)), on
+// blocks of `tile`: the fastest of three load
 // schedules (1, 2 or 4 neighbours' loads at a time) by median. A reference for the gather's
 // memory traffic, not a bound: cuda-fused's L2 prefetch, which it lacks, can beat it.
-TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, double warm_ms);
+TimedWork time_bare_gather(int n, Tile tile, bool velocities, double warm_ms);
 // Compulsory DRAM traffic of one step, bytes per node: every array a kernel touches read or
 // written once per kernel, neighbours served by caches.
 double floor_bytes_per_node(const Model& m, Integrator i, const Options& o);

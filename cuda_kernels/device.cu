@@ -76,18 +76,16 @@ TimedWork time_launches(double warm_ms, int min_calls, Work&& work, const std::s
 }
 
 // cuda-fused's loads and stores on an n x n cloth without its arithmetic: each node reads its x
-// and v, its stencil neighbours' x (and v: Velocities), Verlet's previous position (Previous,
-// from a third array, as cuda-fused's), and writes x and v with the neighbours' components
-// summed in, so that no load is dead. Neighbours outside the grid are skipped; loads go Group
-// at a time.
-template <bool Velocities, bool Previous, int Group>
+// and v and its stencil neighbours' x (and v: Velocities), and writes x and v with the
+// neighbours' components summed in, so that no load is dead. Neighbours outside the grid are
+// skipped; loads go Group at a time.
+template <bool Velocities, int Group>
 __global__ void bare_gather(int n, const float4* __restrict__ x, const float4* __restrict__ v,
-                            const float4* __restrict__ xp, float4* __restrict__ xo, float4* __restrict__ vo) {
+                            float4* __restrict__ xo, float4* __restrict__ vo) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y;
   if (i >= n || j >= n) return;
   const int node = j * n + i;
   float4 sx = x[node], sv = v[node];
-  if (Previous) sx.w += xp[node].x;
   const bool inside = i >= STENCIL_REACH && i < n - STENCIL_REACH && j >= STENCIL_REACH && j < n - STENCIL_REACH;
 #pragma unroll
   for (int g = 0; g < kClothStencil; g += Group) {
@@ -123,30 +121,28 @@ TimedWork time_copy(std::int64_t bytes, int min_reps, double warm_ms) {
   }, "the copy");
 }
 
-TimedWork time_bare_gather(int n, Tile tile, bool velocities, bool previous, double warm_ms) {
+TimedWork time_bare_gather(int n, Tile tile, bool velocities, double warm_ms) {
   const std::int64_t nodes = std::int64_t(n) * n;
-  require_device_memory((previous ? 5 : 4) * nodes * std::int64_t(sizeof(float4)), "the bare gather");
-  Buffer<float4> x, v, xp, xo, vo;
+  require_device_memory(4 * nodes * std::int64_t(sizeof(float4)), "the bare gather");
+  Buffer<float4> x, v, xo, vo;
   x.allocate(std::size_t(nodes), "allocating the bare gather's positions");
   v.allocate(std::size_t(nodes), "allocating the bare gather's velocities");
-  xp.allocate(std::size_t(previous ? nodes : 1), "allocating the bare gather's previous positions");
   xo.allocate(std::size_t(nodes), "allocating the bare gather's output positions");
   vo.allocate(std::size_t(nodes), "allocating the bare gather's output velocities");
-  for (const Buffer<float4>* b : {&x, &v, &xp, &xo, &vo})
+  for (const Buffer<float4>* b : {&x, &v, &xo, &vo})
     check(cudaMemset(b->get(), 0x3c, b->size() * sizeof(float4)), "filling the bare gather's arrays");
   const dim3 threads(unsigned(tile.x), unsigned(tile.y)),
       blocks(unsigned((n + tile.x - 1) / tile.x), unsigned((n + tile.y - 1) / tile.y));
-  using Kernel = void (*)(int, const float4*, const float4*, const float4*, float4*, float4*);
+  using Kernel = void (*)(int, const float4*, const float4*, float4*, float4*);
   auto pick = [&](auto group) -> Kernel {
     constexpr int g = decltype(group)::value;
-    return velocities ? (previous ? bare_gather<true, true, g> : bare_gather<true, false, g>)
-                      : (previous ? bare_gather<false, true, g> : bare_gather<false, false, g>);
+    return velocities ? bare_gather<true, g> : bare_gather<false, g>;
   };
   TimedWork best;
   for (const Kernel kernel : {pick(std::integral_constant<int, 1>{}), pick(std::integral_constant<int, 2>{}),
                               pick(std::integral_constant<int, 4>{})}) {
     TimedWork w = time_launches(warm_ms, 10, [&] {
-      kernel<<<blocks, threads>>>(n, x.get(), v.get(), xp.get(), xo.get(), vo.get());
+      kernel<<<blocks, threads>>>(n, x.get(), v.get(), xo.get(), vo.get());
     }, "the bare gather");
     if (best.ms.empty() || w.median_ms() < best.median_ms()) best = std::move(w);
   }

@@ -123,16 +123,16 @@ __device__ __forceinline__ Vec3f gather_csr(const int* __restrict__ offset, cons
   return f;
 }
 
-// The one-pass update (rule RULE_*) and the constraints of node i, written to (xo, vo); x_prev:
-// Verlet's previous positions.
+// The one-pass update (rule RULE_*) and the constraints of node i, written to (xo, vo);
+// half_step: Verlet's v is the half step's (State::half_step).
 // Returns the node's term of the stop rule (P::displacement).
 template <int Rule>
 __device__ __forceinline__ float advance_node(const StepParams& s, float weight, int i, const float4& x4,
-                                              const float4& v4, const Vec3f& a, const float4* x_prev, bool has_prev,
+                                              const float4& v4, const Vec3f& a, bool half_step,
                                               const Vec3f& end_target, float4* xo, float4* vo) {
   const Vec3f x = xyz(x4);
   Vec3f xn, vn;
-  P::one_pass_update(Rule, weight, x, xyz(v4), a, has_prev, s.dt, xn, vn);
+  P::one_pass_update(Rule, weight, x, xyz(v4), a, half_step, s.dt, xn, vn);
   P::constrain_node(s, i, x4.w, x, end_target, xn, vn);
   xo[i] = f4(xn, x4.w);
   vo[i] = f4(vn, 0.f);
@@ -251,8 +251,8 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
   acc[node] = f4(grid_accel<N, Damped>(s, st, i, j, k, node, x4, v4, w, drag_target), 0.f);
 }
 
-// Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v) and
-// x_prev (Verlet), writes (xo, vo).
+// Force, update and constraints in one kernel (one-force-pass schedules): reads (x, v), writes
+// (xo, vo).
 // With kPrefetchAhead each thread first asks L2 for the state of the node `prefetch` after its
 // own, which a block launched later reads: its loads then wait on L2 rather than on DRAM (H100,
 // paper scene: semi-implicit Euler 4% and Verlet 5% faster at 2048^2, Verlet 6% at 8192^2,
@@ -260,7 +260,7 @@ __global__ void __maxnreg__(kGatherRegisters) force_grid(StepParams s, Stencil s
 template <int N, bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil st, float weight,
                                                          const float4* __restrict__ x, const float4* __restrict__ v,
-                                                         const float4* x_prev, bool has_prev, float4* xo,
+                                                         bool half_step, float4* xo,
                                                          float4* __restrict__ vo, Targets tg, StopCheck check,
                                                          int prefetch) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x, j = blockIdx.y * blockDim.y + threadIdx.y, k = blockIdx.z;
@@ -280,7 +280,7 @@ __global__ void __maxnreg__(kGatherRegisters) fused_grid(StepParams s, Stencil s
       const Window w{x, v, node, s.nx, s.nx * s.ny};
       a = P::node_acceleration(s, node, x4.w, xi, vi, gather_grid<N, Damped>(s, st, i, j, k, xi, vi, w), tg.force);
     }
-    d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+    d = advance_node<Rule>(s, weight, node, x4, v4, a, half_step, tg.end, xo, vo);
   }
   store_displacement(check, d);
 }
@@ -310,15 +310,15 @@ __global__ void force_csr(StepParams s, const int* __restrict__ offset, const Li
 
 template <int Rule, bool Damped>
 __global__ void fused_csr(StepParams s, float weight, const int* __restrict__ offset, const Link* __restrict__ links,
-                          const float4* __restrict__ x, const float4* __restrict__ v, const float4* x_prev,
-                          bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg, StopCheck check) {
+                          const float4* __restrict__ x, const float4* __restrict__ v, bool half_step, float4* xo,
+                          float4* __restrict__ vo, Targets tg, StopCheck check) {
   const std::int64_t t = thread_index();
   float d = 0.f;
   if (t < s.node_count) {
     const int i = int(t);
     const float4 x4 = x[i], v4 = v[i];
     const Vec3f a = csr_accel<Damped>(s, offset, links, x, v, i, x4, v4, tg.force);
-    d = advance_node<Rule>(s, weight, i, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+    d = advance_node<Rule>(s, weight, i, x4, v4, a, half_step, tg.end, xo, vo);
   }
   store_displacement(check, d);
 }
@@ -411,13 +411,13 @@ __global__ void scatter_finish(StepParams s, const float4* __restrict__ x, const
 // One-pass update from acceleration slot 0 (the variants that run forces on their own).
 template <int Rule>
 __global__ void update(StepParams s, float weight, const float4* __restrict__ x, const float4* __restrict__ v,
-                       const float4* __restrict__ acc, const float4* x_prev, bool has_prev, float4* xo,
+                       const float4* __restrict__ acc, bool half_step, float4* xo,
                        float4* __restrict__ vo, Vec3f end_target, StopCheck check) {
   const std::int64_t t = thread_index();
   float d = 0.f;
   if (t < s.node_count) {
     const int i = int(t);
-    d = advance_node<Rule>(s, weight, i, x[i], v[i], xyz(acc[i]), x_prev, has_prev, end_target, xo, vo);
+    d = advance_node<Rule>(s, weight, i, x[i], v[i], xyz(acc[i]), half_step, end_target, xo, vo);
   }
   store_displacement(check, d);
 }

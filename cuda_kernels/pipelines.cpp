@@ -132,10 +132,6 @@ std::int64_t spring_bytes(const ModelSize& m, Variant v) {
   return (m.nodes + 1) * 4 + 2 * m.springs * 16;
 }
 
-int state_sets(Integrator i, Variant v) {
-  return make_schedule(i).rule == UpdateRule::verlet && v != Variant::temporal ? 3 : 2;
-}
-
 std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   const Schedule s = make_schedule(i);
   const std::int64_t n = m.nodes, f4 = 16;
@@ -143,8 +139,7 @@ std::int64_t bytes_needed(const ModelSize& m, Integrator i, const Options& o) {
   b += n * 2 * f4 * s.stage_states;
   const bool one_kernel = (o.variant == Variant::fused || o.variant == Variant::temporal) && s.single_pass();
   if (!one_kernel) b += n * f4 * s.accel_slots;
-  if (s.rule == UpdateRule::verlet) b += n * 2 * f4;  // cuda-temporal: previous positions' pair; else a third (x, v)
-  b += (state_sets(i, o.variant) + 1) * 4;  // the stop rule's largest displacement from each set, and its result
+  b += (kStateSets + 1) * 4;  // the stop rule's largest displacement from each set, and its result
   return b + spring_bytes(m, o.variant);
 }
 
@@ -152,16 +147,15 @@ double floor_bytes_per_node(const Model& m, Integrator i, const Options& o) {
   const Variant v = o.variant;
   const Schedule s = make_schedule(i);
   const double f4 = 16, springs_per_node = m.node_count() ? double(m.spring_count()) / m.node_count() : 0;
-  const double prev = s.rule == UpdateRule::verlet ? f4 : 0;
   const double links = m.topology == Topology::general ? 4 + 2 * springs_per_node * 16 : 0;
   // Force pass: gather reads (x, v) and writes a. Scatter: clears the sums, reads every
   // spring once and (x, v), adds into the sums, then reads them with (x, v) to write a.
   const double force = v == Variant::scatter ? f4 + springs_per_node * 16 + 2 * f4 + 2 * f4 + 3 * f4 + f4
                                              : 3 * f4 + links;
   if (s.single_pass()) {
-    if (v == Variant::fused) return 4 * f4 + prev + links;  // (x, v) in, (x', v') out
-    if (v == Variant::temporal) return (4 * f4 + 2 * prev) / steps_per_launch(o);  // per step, halo not counted
-    return force + 3 * f4 + prev + 2 * f4;                  // update: x, v, a (+ x_prev) in, x', v' out
+    if (v == Variant::fused) return 4 * f4 + links;                         // (x, v) in, (x', v') out
+    if (v == Variant::temporal) return 4 * f4 / steps_per_launch(o);        // per step, halo not counted
+    return force + 3 * f4 + 2 * f4;                                         // update: x, v, a in, x', v' out
   }
   double b = 0;
   for (const Pass& p : s.passes) {

@@ -91,17 +91,15 @@ struct Region {
   }
 };
 
-// Reads (x, v) and x_prev (Verlet), writes k = `steps` steps later (xo, vo) and, for Verlet,
-// the positions one step before those (po). x_prev is not read when has_prev is false.
-// Shared memory: two copies of (x, v) per region cell; Verlet's new positions overwrite the
-// copy holding the previous ones, cell by cell.
+// Reads (x, v), writes k = `steps` steps later (xo, vo); half_step: Verlet's v is the half
+// step's (State::half_step) at the first step. Shared memory: two copies of (x, v) per region
+// cell, a step reading one and writing the other.
 template <int N, bool Damped, int Rule>
 __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
     temporal_grid(StepParams s, Stencil st, float weight, int steps, int3 tile, const float4* __restrict__ x,
-                  const float4* __restrict__ v, const float4* __restrict__ x_prev, bool has_prev,
-                  float4* __restrict__ xo, float4* __restrict__ vo, float4* __restrict__ po, StepTargets tg,
-                  StopCheck check) {
-  constexpr bool kVolume = N == kLatticeStencil, kVerlet = Rule == RULE_VERLET;
+                  const float4* __restrict__ v, bool half_step, float4* __restrict__ xo,
+                  float4* __restrict__ vo, StepTargets tg, StopCheck check) {
+  constexpr bool kVolume = N == kLatticeStencil;
   extern __shared__ float4 sh[];
   const Region<kVolume> r(tile, kHalo * steps);
   const int cells = r.count();
@@ -113,12 +111,11 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
     const int l = r.index(c), g = r.node(s, c);
     sx(0)[l] = x[g];
     sv(0)[l] = v[g];
-    if (kVerlet && has_prev) sx(1)[l] = x_prev[g];
   });
   __syncthreads();
   int cur = 0;
   for (int q = 0; q < steps; ++q) {
-    const bool prev = has_prev || q > 0;
+    const bool half = half_step || q > 0;
     for_each_cell<kVolume>(r.valid(s, kHalo * (q + 1)), [&](int3 c) {
       const int i = r.first.x + c.x, j = r.first.y + c.y, k = r.first.z + c.z, l = r.index(c);
       const int node = P::grid_node(i, j, k, s.nx, s.ny);
@@ -127,7 +124,7 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
       const Window w{sx(cur), sv(cur), l, r.cells.x, r.cells.x * r.cells.y};
       const Vec3f acc = grid_accel<N, Damped>(s, st, i, j, k, node, x4, v4, w, tg.step[q].force);
       Vec3f xn, vn;
-      P::one_pass_update(Rule, weight, xi, vi, acc, prev, s.dt, xn, vn);
+      P::one_pass_update(Rule, weight, xi, vi, acc, half, s.dt, xn, vn);
       P::constrain_node(s, node, x4.w, xi, tg.step[q].end, xn, vn);
       sx(1 - cur)[l] = f4(xn, x4.w);
       sv(1 - cur)[l] = f4(vn, 0.f);
@@ -135,14 +132,13 @@ __global__ void __launch_bounds__(kTemporalThreads, kTemporalBlocksPerSM)
     cur = 1 - cur;
     __syncthreads();
   }
-  // The last step's result is in copy cur, its start in the other (Verlet's previous positions).
+  // The last step's result is in copy cur, its start in the other.
   float d = 0.f;
   for_each_cell<kVolume>(r.owned(s), [&](int3 c) {
     const int l = r.index(c), g = r.node(s, c);
     const float4 xn = sx(cur)[l], vn = sv(cur)[l], xs = sx(1 - cur)[l];
     xo[g] = xn;
     vo[g] = vn;
-    if (kVerlet) po[g] = xs;
     d = fmaxf(d, P::displacement(xyz(xn), xyz(xs), xyz(vn)));
   });
   store_displacement(check, d);

@@ -40,14 +40,13 @@ __device__ __forceinline__ void copy_box(const CUtensorMap& map, void* to, int i
 #endif
 }
 
-// Reads x through the tensor map tx, v through tv where springs are damped (else from v) and
-// x_prev (Verlet), writes (xo, vo): fused_grid on a cloth, its neighbours from the block's box
-// in shared memory.
+// Reads x through the tensor map tx, v through tv where springs are damped (else from v),
+// writes (xo, vo): fused_grid on a cloth, its neighbours from the block's box in shared memory.
 template <bool Damped, int Rule>
 __global__ void __maxnreg__(kGatherRegisters)
     fused_cloth_tma(StepParams s, Stencil st, float weight, const __grid_constant__ CUtensorMap tx,
-                    const __grid_constant__ CUtensorMap tv, const float4* __restrict__ v, const float4* x_prev,
-                    bool has_prev, float4* xo, float4* __restrict__ vo, Targets tg, StopCheck check) {
+                    const __grid_constant__ CUtensorMap tv, const float4* __restrict__ v, bool half_step,
+                    float4* xo, float4* __restrict__ vo, Targets tg, StopCheck check) {
 #if __CUDA_ARCH__ >= 900
   __shared__ __align__(128) float4 box[2][kTmaBoxH * kTmaBoxW];
   __shared__ __align__(8) unsigned long long arrived;
@@ -74,7 +73,7 @@ __global__ void __maxnreg__(kGatherRegisters)
     const float4 x4 = box[0][at], v4 = Damped ? box[1][at] : v[node];
     const Vec3f a = grid_accel<kClothStencil, Damped>(s, st, i, j, 0, node, x4, v4, {box[0], box[1], at, kTmaBoxW, 0},
                                                       tg.force);
-    d = advance_node<Rule>(s, weight, node, x4, v4, a, x_prev, has_prev, tg.end, xo, vo);
+    d = advance_node<Rule>(s, weight, node, x4, v4, a, half_step, tg.end, xo, vo);
   }
   store_displacement(check, d);
 #endif

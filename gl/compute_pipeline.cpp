@@ -66,19 +66,18 @@ class ComputePipeline final : public GlPipeline {
   // Window by window (node_windows): the inputs bound over the nodes the window reads, the
   // outputs over the nodes it writes; step.comp offsets its indices by both.
   void run_pass(GLuint program, const PassIO& io) override {
-    const NodeBuffer* in[5] = {io.s0_x, io.s0_v, io.s0_p, io.src_x, io.src_v};
+    const NodeBuffer* in[4] = {io.s0_x, io.s0_v, io.src_x, io.src_v};
     glUseProgram(program);
     if (io.result_max) {
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.result_max);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, io.posted);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, io.result_max);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, io.posted);
       glUniform1i(kResultWord, io.result_word);
       glUniform1ui(kLaunch, io.launch);
     }
     for (const NodeWindow& w : windows_) {
-      for (int k = 0; k < 5; ++k)
-        if (in[k]->id) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
-      for (int k = 0; k < io.outputs; ++k) bind_nodes(GLuint(5 + k), *io.out[k], w.first, w.count);
-      if (io.forces_acc) bind_nodes(8, *io.forces_acc, w.read_first, w.read_count);
+      for (int k = 0; k < 4; ++k) bind_nodes(GLuint(k), *in[k], w.read_first, w.read_count);
+      for (int k = 0; k < io.outputs; ++k) bind_nodes(GLuint(4 + k), *io.out[k], w.first, w.count);
+      if (io.forces_acc) bind_nodes(7, *io.forces_acc, w.read_first, w.read_count);
       glUniform1i(kFirst, w.first);
       glUniform1i(kCount, w.count);
       glUniform1i(kReadFirst, w.read_first);

@@ -24,7 +24,7 @@ void GlPipeline::step_back() {
   clear_word(cur_);  // the step taken back added into the word the next step reduces into
   cur_ = 1 - cur_;
   t_ = back_t_;
-  has_prev_ = back_has_prev_;
+  half_step_ = back_half_step_;
   back_ = Back::taken;
 }
 

@@ -95,8 +95,7 @@ std::string idle_option(const PipelineOptions& o, Topology t) {
 
 Footprint footprint(const ModelSize& m, Integrator i, bool outside_forces) {
   const Schedule s = make_schedule(i);
-  const std::int64_t n = m.nodes, node_buffers = 4 + (s.rule == UpdateRule::verlet ? 2 : 0) + 3 * s.stage_states +
-                                                 (outside_forces ? 1 : 0);
+  const std::int64_t n = m.nodes, node_buffers = 4 + 3 * s.stage_states + (outside_forces ? 1 : 0);
   const std::int64_t chunk = 16 * std::min<std::int64_t>(n, kTransferChunkNodes);  // staging, host and GPU
   const std::int64_t adjacency = m.grid || outside_forces ? 0 : (n + 1) * 4 + 2 * m.springs * 16;
   return {chunk, n * 16 * node_buffers + adjacency + chunk};
@@ -244,7 +243,6 @@ void GlPipeline::make_buffers() {
   for (int k = 0; k < 2; ++k) {
     x_[k] = node_buffer(true);
     v_[k] = node_buffer(true);
-    if (rule_ == UpdateRule::verlet) xp_[k] = node_buffer(false);
   }
   for (int k = 0; k < sched_.stage_states; ++k) {
     sx_[k] = node_buffer(true);
@@ -319,13 +317,13 @@ void GlPipeline::init() {
                              (math_ == Math::exact ? "#define MATH_EXACT 1\n" : "#define MATH_FAST 1\n") +
                              (shared_ ? "#define EXTERNAL_FORCES 1\n" : "");
   for (GpuPass& g : passes_) {
-    const int outputs = g.kind == PassKind::stage || rule_ == UpdateRule::verlet ? 3 : 2;
+    const int outputs = g.kind == PassKind::stage ? 3 : 2;
     g.prog = make_program(outputs, std::string("#define PASS ") + kind_define[int(g.kind)] + "\n#define STAGE " +
                                        std::to_string(g.stage) + "\n" + common);
     const GLuint id = g.prog.id();
     g.drag_force_target = uniform(id, "u_drag_force_target");
     g.drag_next = uniform(id, "u_drag_next");
-    g.has_prev = uniform(id, "u_has_prev");
+    g.half_step = uniform(id, "u_half_step");
     glProgramUniform1fv(id, uniform(id, "u_weights"), kMaxStages, g.weights.data());
   }
   reduce_ = gl::make_program({{GL_COMPUTE_SHADER, "reduce.comp"}});
@@ -339,8 +337,7 @@ void GlPipeline::init() {
 
 void GlPipeline::set_state(const State& s) {
   const std::size_t n = std::size_t(n_);
-  if (s.x.size() != n || s.v.size() != n || (!s.x_prev.empty() && s.x_prev.size() != n))
-    throw std::invalid_argument("state size does not match the model");
+  if (s.x.size() != n || s.v.size() != n) throw std::invalid_argument("state size does not match the model");
   context();
   // A chunk at a time through one staging buffer, then a shader copy (see shaders/copy.comp:
   // node buffers may be memory imported from CUDA).
@@ -368,8 +365,7 @@ void GlPipeline::set_state(const State& s) {
   };
   upload(x_[cur_], s.x, true);
   upload(v_[cur_], s.v, false);
-  has_prev_ = !s.x_prev.empty() && rule_ == UpdateRule::verlet;
-  if (has_prev_) upload(xp_[cur_], s.x_prev, true);
+  half_step_ = s.half_step;
   const std::uint32_t zero = 0;
   glClearNamedBufferData(result_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glMemoryBarrier(GL_ALL_BARRIER_BITS);
@@ -406,7 +402,7 @@ State GlPipeline::state() {
   s.t = t_;
   download(x_[cur_], s.x);
   download(v_[cur_], s.v);
-  if (has_prev_) download(xp_[cur_], s.x_prev);
+  s.half_step = half_step_;
   check(name_ + " state read-back");
   return s;
 }
@@ -461,21 +457,20 @@ void GlPipeline::update(const Pass& pass) {
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_ubo_.id());
   glProgramUniform3f(id, g.drag_force_target, target.x, target.y, target.z);
   glProgramUniform3f(id, g.drag_next, next.x, next.y, next.z);
-  glProgramUniform1i(id, g.has_prev, has_prev_ ? 1 : 0);
+  glProgramUniform1i(id, g.half_step, half_step_ ? 1 : 0);
   bind_textures(g.stage);
   PassIO io{};
   io.set = c;
   io.s0_x = &x_[c];
   io.s0_v = &v_[c];
-  io.s0_p = &xp_[c];
   io.src_x = g.stage == 0 ? &x_[c] : &sx_[g.stage - 1];
   io.src_v = g.stage == 0 ? &v_[c] : &sv_[g.stage - 1];
   if (g.kind == PassKind::stage) {
     io.out = {&sa_[g.stage], &sx_[g.stage], &sv_[g.stage]};
     io.outputs = 3;
   } else {
-    io.out = {&x_[d], &v_[d], &xp_[d]};
-    io.outputs = rule_ == UpdateRule::verlet ? 3 : 2;
+    io.out = {&x_[d], &v_[d], nullptr};
+    io.outputs = 2;
     io.result_max = result_.id();
     io.result_word = d;
     io.posted = readback_.id();
@@ -492,11 +487,11 @@ void GlPipeline::finish_step() {
   next_pass_ = 0;
   cur_ = 1 - cur_;
   back_t_ = t_;
-  back_has_prev_ = has_prev_;
+  back_half_step_ = half_step_;
   back_ = Back::possible;
   t_ += p_.dt;
   stepped_ = true;
-  if (rule_ == UpdateRule::verlet) has_prev_ = true;
+  if (rule_ == UpdateRule::verlet) half_step_ = true;
 }
 
 std::array<GLuint, 2> GlPipeline::slot_buffers(int slot) const {

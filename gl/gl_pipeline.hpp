@@ -118,11 +118,10 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     Texture tex;    // texture buffer view (RGBA32F)
   };
   // What one pass reads and writes (besides the earlier stages' slopes, bound as textures
-  // for both pipelines). s0: the current state (and Verlet's previous positions); src: the
-  // state the forces are evaluated at.
+  // for both pipelines). s0: the current state; src: the state the forces are evaluated at.
   struct PassIO {
     int set;  // index of the current state set (VAO set of the TF pipeline)
-    const NodeBuffer *s0_x, *s0_v, *s0_p, *src_x, *src_v;
+    const NodeBuffer *s0_x, *s0_v, *src_x, *src_v;
     std::array<const NodeBuffer*, 3> out;
     int outputs;
     const NodeBuffer* forces_acc;  // accelerations from an outside force stage, else null
@@ -173,7 +172,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   // The own node buffers' memory. Declared before the buffers, so destroyed after them.
   std::unique_ptr<NodeMemory> memory_;
   NodeBuffer forces_acc_;  // what the outside force stage writes
-  std::array<NodeBuffer, 2> x_, v_, xp_;  // state sets, ping-pong (xp_: Verlet)
+  std::array<NodeBuffer, 2> x_, v_;  // state sets, ping-pong
   // Runge-Kutta stages: sx_[k], sv_[k] the state of stage k + 1, sa_[k] the acceleration at stage k.
   std::array<NodeBuffer, kMaxStages - 1> sx_, sv_, sa_;
 
@@ -183,7 +182,7 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
     int stage;
     std::array<float, kMaxStages> weights;  // of the slopes 0..stage (one: b_0)
     Program prog;
-    GLint drag_force_target, drag_next, has_prev;
+    GLint drag_force_target, drag_next, half_step;
   };
   // memory_ and chosen_ from option "memory".
   void choose_memory(const PipelineOptions& o, const CudaMemory& cuda);
@@ -239,13 +238,13 @@ class GlPipeline : public Pipeline, public ForceStage, public UpdateStage {
   Profiler* prof_ = nullptr;
   TimerSpans spans_;  // the profiled steps
   int cur_ = 0;
-  bool has_prev_ = false, stepped_ = false;
+  bool half_step_ = false, stepped_ = false;
   double t_ = 0.0;
   // Whether the last step can be taken back, and what it changed besides cur_.
   enum class Back { none, possible, taken };
   Back back_ = Back::none;
   double back_t_ = 0.0;
-  bool back_has_prev_ = false;
+  bool back_half_step_ = false;
 };
 
 }  // namespace deformlab::gl

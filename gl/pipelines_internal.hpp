@@ -16,7 +16,7 @@ std::unique_ptr<Pipeline> make_tf_pipeline(const PipelineSetup& s, const CudaMem
 std::unique_ptr<Pipeline> make_compute_pipeline(const PipelineSetup& s, const CudaMemory& cuda = {});
 // The same passes reading each node's acceleration from buffers allocated by `shared` and
 // written by an outside force stage (the update passes of the hybrid pipelines); their own
-// buffers (Verlet's previous positions, the Runge-Kutta slopes) from `cuda` where available.
+// buffers (the Runge-Kutta slopes) from `cuda` where available.
 std::unique_ptr<GlPipeline> make_tf_update(const PipelineSetup& s, SharedAllocator shared, const CudaMemory& cuda = {});
 std::unique_ptr<GlPipeline> make_compute_update(const PipelineSetup& s, SharedAllocator shared,
                                                 const CudaMemory& cuda = {});

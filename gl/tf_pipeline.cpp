@@ -22,9 +22,8 @@ class TfPipeline final : public GlPipeline {
       glGenVertexArrays(1, &id);
       vao_[k] = VertexArray(id);
       glBindVertexArray(id);
-      const GLuint attrs[3] = {x_[k].id, v_[k].id, xp_[k].id};
-      for (GLuint a = 0; a < 3; ++a) {
-        if (!attrs[a]) continue;
+      const GLuint attrs[2] = {x_[k].id, v_[k].id};
+      for (GLuint a = 0; a < 2; ++a) {
         glBindBuffer(GL_ARRAY_BUFFER, attrs[a]);
         glVertexAttribPointer(a, 4, GL_FLOAT, GL_FALSE, 0, nullptr);
         glEnableVertexAttribArray(a);

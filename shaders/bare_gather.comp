@@ -1,17 +1,14 @@
 #version 430 core
 // glsl-compute's bare gather: step.comp's loads and stores on an n x n cloth (its work groups,
 // its stencil, the fast build's unrolled loops) without its arithmetic. Each invocation reads its
-// node's x and v and its neighbours' x and v (step.comp reads them for every spring), with
-// PREVIOUS also Verlet's previous position, and writes them back with the neighbours'
-// components summed in, so that no load is dead. Defines: TILE_X, TILE_Y, STENCIL_SIZE,
+// node's x and v and its neighbours' x and v (step.comp reads them for every spring), and
+// writes them back with the neighbours' components summed in, so that no load is dead. Defines: TILE_X, TILE_Y, STENCIL_SIZE,
 // STENCIL_OFFSETS.
 layout(local_size_x = TILE_X, local_size_y = TILE_Y) in;
 layout(std430, binding = 0) readonly buffer X { vec4 x[]; };
 layout(std430, binding = 1) readonly buffer V { vec4 v[]; };
-layout(std430, binding = 2) readonly buffer P { vec4 p[]; };
-layout(std430, binding = 3) writeonly buffer XO { vec4 xo[]; };
-layout(std430, binding = 4) writeonly buffer VO { vec4 vo[]; };
-layout(std430, binding = 5) writeonly buffer PO { vec4 po[]; };
+layout(std430, binding = 2) writeonly buffer XO { vec4 xo[]; };
+layout(std430, binding = 3) writeonly buffer VO { vec4 vo[]; };
 layout(location = 0) uniform int u_n;
 
 #pragma optionNV(unroll all)
@@ -32,7 +29,4 @@ void main() {
   }
   xo[node] = sx;
   vo[node] = sv;
-#ifdef PREVIOUS
-  po[node] = p[node];
-#endif
 }

@@ -39,7 +39,7 @@
 #endif
 #include "node_physics.h"
 
-#define PASS_ONE 0     // one force pass and the step's result: o0 = x', o1 = (v', displacement), o2 = x (Verlet)
+#define PASS_ONE 0     // one force pass and the step's result: o0 = x', o1 = (v', displacement)
 #define PASS_STAGE 1   // forces at stage STAGE, then stage STAGE+1: o0 = a, o1 = x, o2 = v
 #define PASS_RESULT 2  // forces at the last stage, then the step's result: o0 = x', o1 = (v', displacement)
 
@@ -52,7 +52,7 @@ layout(std140, binding = 0) uniform Sim {
 uniform vec3 u_drag_force_target;  // spring drag: target at this pass's force time
 uniform vec3 u_drag_next;          // hard drag: target at t + dt
 uniform float u_weights[4];        // Runge-Kutta weights of the slopes 0..STAGE (PASS_ONE: b_0)
-uniform bool u_has_prev;           // Verlet: previous positions are valid
+uniform bool u_half_step;          // Verlet: v is the half step's (State::half_step)
 
 // Earlier stages' slopes: velocities of stage states 1..3, accelerations of stages 0..2.
 layout(binding = 2) uniform samplerBuffer u_stage_v[3];
@@ -121,8 +121,8 @@ vec3 springs_on(int i, vec3 xi, vec3 vi) {
   return f;
 }
 
-// The pass for node i from the current state (x0, v0) and, for Verlet, the previous position xp.
-void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out vec4 o2) {
+// The pass for node i from the current state (x0, v0); o2 is written by stage passes only.
+void node_pass(int i, vec4 x0, vec4 v0, out vec4 o0, out vec4 o1, out vec4 o2) {
   float w = x0.w, dt = params.dt;
   vec3 xs = src_x(i).xyz, vs = src_v(i).xyz;
 #ifdef EXTERNAL_FORCES
@@ -134,8 +134,7 @@ void node_pass(int i, vec4 x0, vec4 v0, vec4 xp, out vec4 o0, out vec4 o1, out v
   vec3 x, v;
   o2 = vec4(0.0);
 #if PASS == PASS_ONE
-  one_pass_update(RULE, u_weights[0], x0.xyz, v0.xyz, a, u_has_prev, dt, x, v);
-  o2 = x0;
+  one_pass_update(RULE, u_weights[0], x0.xyz, v0.xyz, a, u_half_step, dt, x, v);
 #else
   vec3 dx = vec3(0.0), dv = vec3(0.0);
   if (STAGE > 0 && u_weights[0] != 0.0) add_slope(dx, dv, u_weights[0], v0.xyz, texelFetch(u_stage_a[0], i).xyz);

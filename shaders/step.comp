@@ -20,17 +20,16 @@ layout(location = 5) uniform uint u_launch;     // result passes: their number (
 
 layout(std430, binding = 0) readonly buffer S0X { vec4 s0_x[]; };  // current state
 layout(std430, binding = 1) readonly buffer S0V { vec4 s0_v[]; };
-layout(std430, binding = 2) readonly buffer SP { vec4 s0_p[]; };   // Verlet: previous positions
-layout(std430, binding = 3) readonly buffer SrcX { vec4 src_x_[]; };  // forces evaluated here
-layout(std430, binding = 4) readonly buffer SrcV { vec4 src_v_[]; };
-layout(std430, binding = 5) writeonly buffer O0 { vec4 out0[]; };
-layout(std430, binding = 6) writeonly buffer O1 { vec4 out1[]; };
-layout(std430, binding = 7) writeonly buffer O2 { vec4 out2[]; };
+layout(std430, binding = 2) readonly buffer SrcX { vec4 src_x_[]; };  // forces evaluated here
+layout(std430, binding = 3) readonly buffer SrcV { vec4 src_v_[]; };
+layout(std430, binding = 4) writeonly buffer O0 { vec4 out0[]; };
+layout(std430, binding = 5) writeonly buffer O1 { vec4 out1[]; };
+layout(std430, binding = 6) writeonly buffer O2 { vec4 out2[]; };
 
 vec4 src_x(int j) { return src_x_[j - u_read_first]; }
 vec4 src_v(int j) { return src_v_[j - u_read_first]; }
 #ifdef EXTERNAL_FORCES
-layout(std430, binding = 8) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
+layout(std430, binding = 7) readonly buffer ForcesAcc { vec4 forces_acc_[]; };  // from the force stage
 vec4 forces_acc(int i) { return forces_acc_[i - u_read_first]; }
 #endif
 
@@ -48,8 +47,8 @@ ivec3 node_cell(int i) { return cell_; }
 // group 0 of the first window posts the other word, the step before's (complete: its pass
 // ended at a barrier), to the host, tagged with that pass's number, and clears it for the step
 // after.
-layout(std430, binding = 9) buffer StepMax { uint step_max[2]; };
-layout(std430, binding = 10) writeonly buffer Posted { uvec2 posted; };  // mapped by the host
+layout(std430, binding = 8) buffer StepMax { uint step_max[2]; };
+layout(std430, binding = 9) writeonly buffer Posted { uvec2 posted; };  // mapped by the host
 shared uint group_term;
 #endif
 
@@ -70,16 +69,11 @@ void main() {
 #endif
   if (l >= 0 && l < u_count) {
     int i = u_first + l, r = i - u_read_first;
-#if PASS == PASS_ONE && RULE == RULE_VERLET
-    vec4 xp = s0_p[r];
-#else
-    vec4 xp = vec4(0.0);
-#endif
     vec4 o0, o1, o2;
-    node_pass(i, s0_x[r], s0_v[r], xp, o0, o1, o2);
+    node_pass(i, s0_x[r], s0_v[r], o0, o1, o2);
     out0[l] = o0;
     out1[l] = o1;
-#if PASS == PASS_STAGE || (PASS == PASS_ONE && RULE == RULE_VERLET)
+#if PASS == PASS_STAGE
     out2[l] = o2;
 #endif
 #if PASS != PASS_STAGE

@@ -3,7 +3,6 @@
 // (the rasteriser discarded); neighbours read through texture buffers over the state.
 layout(location = 0) in vec4 in_x;  // current position, w: inverse mass
 layout(location = 1) in vec4 in_v;  // current velocity
-layout(location = 2) in vec4 in_p;  // Verlet: previous position
 
 layout(binding = 0) uniform samplerBuffer u_src_x;  // state the forces are evaluated at
 layout(binding = 1) uniform samplerBuffer u_src_v;
@@ -26,4 +25,4 @@ ivec3 node_cell(int i) {
 
 out vec4 o0, o1, o2;
 
-void main() { node_pass(gl_VertexID, in_x, in_v, in_p, o0, o1, o2); }
+void main() { node_pass(gl_VertexID, in_x, in_v, o0, o1, o2); }

@@ -27,13 +27,13 @@ std::string Session::replace(const PipelineEntry& e, Integrator i, const Pipelin
   Params p = s_.params;
   p.dt = dt;
   State st = pipe_->state();
-  // Verlet's previous positions belong to its own dt: another rule or step starts from (x, v).
-  if (i != s_.integrator || dt != s_.params.dt) st.x_prev.clear();
+  // Verlet's half-step velocity belongs to its own dt: another rule or step starts from (x, v).
+  if (i != s_.integrator || dt != s_.params.dt) st.half_step = false;
   try {
     std::unique_ptr<Pipeline> next = make(e, i, o, p);
     next->set_state(st);
     const State back = next->state();
-    carried_exactly_ = back.t == st.t && back.x == st.x && back.v == st.v && back.x_prev == st.x_prev;
+    carried_exactly_ = back.t == st.t && back.x == st.x && back.v == st.v && back.half_step == st.half_step;
     pipe_ = std::move(next);
   } catch (const std::exception& ex) {
     return ex.what();

@@ -1,5 +1,5 @@
 // What only the CUDA pipelines have: graphs and tile shapes that change no bit, Verlet's
-// given previous positions, the device's displacement reduction, memory checks,
+// given half-step velocity, the device's displacement reduction, memory checks,
 // the registry's variants and the profiled passes. Against the CPU: tests/match.
 #include <gtest/gtest.h>
 
@@ -89,13 +89,13 @@ TEST(CudaPipeline, EveryTileShapeGivesTheSameBits) {
   }
 }
 
-TEST(CudaPipeline, VerletContinuesFromAGivenPreviousPosition) {
+TEST(CudaPipeline, VerletContinuesFromAHalfStepVelocity) {
   DEFORMLAB_REQUIRE_CUDA();
   const Model m = make_model(kShapes[1]);
   const Params p = scene_params();
   auto cpu = make_cpu_pipeline({m, p, Integrator::verlet}, Precision::f32, false);
   const State mid = advance(*cpu, perturbed_state(m, 5u), 4);
-  ASSERT_FALSE(mid.x_prev.empty());
+  ASSERT_TRUE(mid.half_step);
   const State want = advance(*cpu, mid, kSteps);
   for (Variant v : {Variant::naive, Variant::tiled, Variant::fused}) {
     auto g = cuda::make_pipeline({m, p, Integrator::verlet}, options(v));

@@ -56,7 +56,7 @@ TEST_P(ModesAgree, BitwiseEqualStates) {
       first = s;
       continue;
     }
-    EXPECT_TRUE(bitwise_equal(s.x, first->x) && bitwise_equal(s.v, first->v) && bitwise_equal(s.x_prev, first->x_prev))
+    EXPECT_TRUE(bitwise_equal(s, *first))
         << to_string(m) << " differs from map: |dx| = " << max_position_diff(s, *first) << " m";
   }
 }

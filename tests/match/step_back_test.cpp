@@ -114,7 +114,7 @@ TEST_P(StepBack, LaggedChecksCatchDivergenceAtTheSameStep) {
   EXPECT_EQ(lagged.s.t, lagged.diverged_at * double(p.dt)) << "the launch after the divergence was not taken back";
 }
 
-// Bit for bit (previous positions included), or within a few ulp of the 1 m coordinates (the
+// Bit for bit, or within a few ulp of the 1 m coordinates (the
 // scatter kernels' atomic order).
 void expect_same(const State& a, const State& b, bool bitwise) {
   if (bitwise) {
@@ -173,8 +173,7 @@ void StepBack::takes_the_last_launch_back_once(Integrator integ) {
 }
 
 // Which pipelines take the lagged path: those whose kernels or passes write a state set other
-// than the one they read and the one before it (the one-step CUDA Verlet kernels keep three
-// sets of positions, cuda-temporal a pair of previous positions), every GPU pipeline.
+// than the one they read, every GPU pipeline.
 TEST(StepBackPipelines, PingPongPipelinesCanStepBack) {
   const std::set<std::string> can = {"cuda-fused",   "cuda-tiled", "cuda-naive", "cuda-scatter",  "cuda-temporal",
                                      "glsl-compute", "glsl-tf",    "hybrid",     "hybrid-compute"};

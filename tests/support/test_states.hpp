@@ -59,14 +59,14 @@ struct RoundingBound {
 // The bound from `cpu`'s float state `a` and the double reference's `r` after the same steps.
 RoundingBound rounding_bound(const State& a, const State& r, Bound floor, double times = 8);
 // A floor of 4 ulp of the state's largest coordinate (at least 1 mm's), for velocities turned
-// into a velocity by 1/dt (Verlet's v is a position difference over dt).
+// into a velocity by 1/dt.
 Bound ulp_floor(const State& s, float dt);
 // `g` within `b` of `a`: positions and velocities, each by its largest node distance and its
-// root mean square, and previous positions by their largest; the message gives each. Fails
+// root mean square, and the same half_step; the message gives each. Fails
 // where a bound is not finite (a NaN or infinity in the states it came from).
 testing::AssertionResult within_rounding(const State& g, const State& a, const RoundingBound& b);
 
-// Equal bit for bit (positions, velocities, previous positions, time).
+// Equal bit for bit (positions, velocities, half_step, time).
 bool bitwise_equal(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b);
 bool bitwise_equal(const State& a, const State& b);
 

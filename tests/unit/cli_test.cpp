@@ -266,7 +266,7 @@ TEST_F(Cli, SummarySaysInHowManyStepsAStageRan) {
 }
 
 // A 4096x4096 cloth (16.8 M nodes) on cpu within memory: the model is its nodes (16 bytes
-// each), the whole run peaks near what the memory check counts (model, the pipeline's 6
+// each), the whole run peaks near what the memory check counts (model, the pipeline's 5
 // vectors of floats, one state) and the final state streams into state.ply.
 TEST_F(Cli, LargeClothRunsWithinItsCountedMemory) {
   const fs::path out = dir_ / "large";
@@ -278,14 +278,17 @@ TEST_F(Cli, LargeClothRunsWithinItsCountedMemory) {
   const auto& mem = m["memory"];
   const double counted = mem["model_host_bytes"].get<double>() + mem["pipeline_host_bytes"].get<double>() +
                          mem["state_host_bytes"].get<double>();
-  EXPECT_EQ(counted, (16 + 72 + 36) * nodes);
+  EXPECT_EQ(counted, (16 + 60 + 24) * nodes);
 #ifdef __SANITIZE_ADDRESS__
   // AddressSanitizer adds a shadow byte per 8 and holds freed blocks in a 256 MiB quarantine.
   const double sanitizer = counted / 8 + (256 << 20);
 #else
   const double sanitizer = 0.0;
 #endif
-  EXPECT_LT(mem["peak_resident_bytes"].get<double>(), counted + sanitizer + (64 << 20)) << "peak resident bytes";
+  // Beyond what is counted: the process's own (its libraries, about 50 MB in a run of an 8 x 8
+  // cloth) and the output's buffers.
+  EXPECT_LT(mem["peak_resident_bytes"].get<double>(), counted + sanitizer + (128 << 20)) << "peak resident bytes";
+  EXPECT_GT(mem["peak_resident_bytes"].get<double>(), counted) << "peak resident bytes";
   std::string head(4096, '\0');
   std::ifstream(out / "state.ply", std::ios::binary).read(head.data(), std::streamsize(head.size()));
   EXPECT_EQ(fs::file_size(out / "state.ply"), head.find("end_header\n") + 11 + nodes * 24 + 2 * 4095.0 * 4095.0 * 13);

@@ -287,8 +287,8 @@ TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {
   EXPECT_LE(double(limit->bytes), 1.1 * std::max(before, after));
   if (limit->name == "MemAvailable (/proc/meminfo)") EXPECT_GE(double(limit->bytes), 0.9 * std::min(before, after));
   else EXPECT_EQ(limit->name.rfind("the cgroup's memory limit (", 0), 0u) << limit->name;
-  // Semi-implicit Euler on cpu: slots (x, v), one acceleration, next (x, v), x_prev: 6 vec3 of floats.
-  EXPECT_EQ(cpu.footprint(small, Integrator::semi_implicit_euler, {}).host, small.nodes * 6 * 12);
+  // Semi-implicit Euler on cpu: slots (x, v), one acceleration, next (x, v): 5 vec3 of floats.
+  EXPECT_EQ(cpu.footprint(small, Integrator::semi_implicit_euler, {}).host, small.nodes * 5 * 12);
   // 2^30 nodes by backward Euler in doubles: terabytes, more than any machine here has.
   const ModelSize big{std::int64_t(1) << 30, 6 * (std::int64_t(1) << 30), true};
   const PipelineEntry& ref = *r.find("reference");
@@ -298,18 +298,18 @@ TEST(Pipelines, HostMemoryCheckNamesTheNeedAndTheLimit) {
   const std::string why = host_memory_shortfall(big, ref, Integrator::backward_euler, {});
   EXPECT_NE(why.find("on reference needs " + gib(need) + " of host memory (model 16 GiB, pipeline "), std::string::npos)
       << why;
-  EXPECT_NE(why.find(", state 36 GiB); " + limit->name + " leaves " + gib(limit->bytes)), std::string::npos) << why;
+  EXPECT_NE(why.find(", state 24 GiB); " + limit->name + " leaves " + gib(limit->bytes)), std::string::npos) << why;
   EXPECT_NE(host_memory_shortfall({(std::int64_t(1) << 30) + 1, 0, true}, cpu, Integrator::verlet, {})
                 .find("exceeds the limit of 2^30 nodes"),
             std::string::npos);
   // With --compare, the reference pipeline (doubles) and its state are counted too:
-  // 6 vec3 of doubles and a state, 180 GiB at 2^30 nodes.
+  // 5 vec3 of doubles and a state, 144 GiB at 2^30 nodes.
   const std::string both = host_memory_shortfall(big, cpu, Integrator::semi_implicit_euler, {}, &ref);
-  EXPECT_NE(both.find("reference pipeline and state 180 GiB"), std::string::npos) << both;
-  // Before a pipeline is chosen (`view`'s best): the model and its state alone, 52 GiB.
+  EXPECT_NE(both.find("reference pipeline and state 144 GiB"), std::string::npos) << both;
+  // Before a pipeline is chosen (`view`'s best): the model and its state alone, 40 GiB.
   const std::string model = model_memory_shortfall(big, Integrator::semi_implicit_euler);
   if (model_host_bytes(big) + state_host_bytes(big.nodes) > limit->bytes)
-    EXPECT_EQ(model, "a model of 1073741824 nodes needs at least 52 GiB of host memory (model 16 GiB, state 36 GiB); " +
+    EXPECT_EQ(model, "a model of 1073741824 nodes needs at least 40 GiB of host memory (model 16 GiB, state 24 GiB); " +
                          limit->name + " leaves " + gib(limit->bytes));
   else
     EXPECT_EQ(model, "");
