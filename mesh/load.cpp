@@ -15,6 +15,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "child_read.hpp"
@@ -78,30 +79,60 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   }
 };
 
-// Appends the vertices of `a` that its faces use to `position`, those at one position once, in
-// the order of their first index; returns the index in `position` of each of a's vertices.
+// A vertex's position as its bits, -0 taken for 0: positions are joined where these are equal.
+using PositionBits = std::array<std::uint32_t, 3>;
+PositionBits position_bits(const aiVector3D& p) {
+  return std::bit_cast<PositionBits>(Vec3f{p.x + 0.f, p.y + 0.f, p.z + 0.f});
+}
+struct HashBits {
+  std::size_t operator()(const PositionBits& b) const {
+    return std::hash<std::uint64_t>{}((std::uint64_t(b[0]) << 32 | b[1]) ^ (std::uint64_t(b[2]) * 0x9e3779b97f4a7c15u));
+  }
+};
+using PositionIndex = std::unordered_map<PositionBits, std::int32_t, HashBits>;
+
+// f(node) for each node of the file's scene graph: its objects. assimp splits an object into a
+// mesh per material (OBJ) or per primitive (glTF), all of them under its node.
+template <class F>
+void for_each_object(const aiScene& scene, F f) {
+  std::vector<const aiNode*> todo{scene.mRootNode};
+  while (!todo.empty()) {
+    const aiNode* n = todo.back();
+    todo.pop_back();
+    f(*n);
+    todo.insert(todo.end(), n->mChildren, n->mChildren + n->mNumChildren);
+  }
+}
+
+// Appends the vertices of `a` that its faces use to `position`, those at a position already in
+// `first` (its object's, as this object's meshes add them) or repeated in `a` once, in the
+// order of their first index; returns the index in `position` of each of a's vertices.
 // (assimp's own aiProcess_JoinIdenticalVertices also joins vertices within about 1e-5 of a
 // file unit, which would turn a fine mesh's small triangles into degenerate ones.)
-std::vector<std::int32_t> join_identical_vertices(const aiMesh& a, std::vector<Vec3f>& position) {
+std::vector<std::int32_t> join_identical_vertices(const aiMesh& a, PositionIndex& first, std::vector<Vec3f>& position) {
   std::vector<std::int32_t> vertex(a.mNumVertices, -1);
   for (unsigned f = 0; f < a.mNumFaces; ++f)
     for (unsigned i = 0; i < a.mFaces[f].mNumIndices; ++i) vertex[a.mFaces[f].mIndices[i]] = 0;
-  struct Bits {
-    std::size_t operator()(const std::array<std::uint32_t, 3>& b) const {
-      const std::uint64_t mixed = (std::uint64_t(b[0]) << 32 | b[1]) ^ (std::uint64_t(b[2]) * 0x9e3779b97f4a7c15u);
-      return std::hash<std::uint64_t>{}(mixed);
-    }
-  };
-  std::unordered_map<std::array<std::uint32_t, 3>, std::int32_t, Bits> first;
   for (unsigned v = 0; v < a.mNumVertices; ++v) {
     if (vertex[v] < 0) continue;
-    const Vec3f p{a.mVertices[v].x + 0.f, a.mVertices[v].y + 0.f, a.mVertices[v].z + 0.f};  // -0 is 0
-    const auto [at, fresh] = first.try_emplace(std::bit_cast<std::array<std::uint32_t, 3>>(p),
-                                               std::int32_t(position.size()));
-    if (fresh) position.push_back(p);
+    const auto [at, fresh] = first.try_emplace(position_bits(a.mVertices[v]), std::int32_t(position.size()));
+    if (fresh) position.push_back(std::bit_cast<Vec3f>(at->first));
     vertex[v] = at->second;
   }
   return vertex;
+}
+
+// The positions of an object's vertices that no face of it uses, over its meshes.
+std::int64_t unused_positions(const aiScene& scene, const aiNode& object) {
+  std::unordered_set<PositionBits, HashBits> all, used;
+  for (unsigned k = 0; k < object.mNumMeshes; ++k) {
+    const aiMesh& a = *scene.mMeshes[object.mMeshes[k]];
+    for (unsigned v = 0; v < a.mNumVertices; ++v) all.insert(position_bits(a.mVertices[v]));
+    for (unsigned f = 0; f < a.mNumFaces; ++f)
+      for (unsigned i = 0; i < a.mFaces[f].mNumIndices; ++i)
+        if (a.mFaces[f].mIndices[i] < a.mNumVertices) used.insert(position_bits(a.mVertices[a.mFaces[f].mIndices[i]]));
+  }
+  return std::int64_t(all.size() - used.size());
 }
 
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
@@ -114,24 +145,21 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
                                                           aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
                                                           aiComponent_TEXTURES | aiComponent_LIGHTS |
                                                           aiComponent_CAMERAS | aiComponent_MATERIALS);
-  // One mesh per object: vertices shared across them are left for repair() to weld and count.
+  // Meshes kept under their objects: vertices shared across objects are left for repair() to
+  // weld and count.
   importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
   // Read first and checked for coordinates that are not finite, those of vertices no face uses
   // too, then processed.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
   if (!scene) refused_by_assimp(path, importer);
-  // Vertices no face uses are left out below: counted here.
-  std::int64_t unused = 0;
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
     for (unsigned v = 0; v < a->mNumVertices; ++v)
       if (const aiVector3D& p = a->mVertices[v]; !finite_vertex({p.x, p.y, p.z})) bad(path, non_finite_vertex({p.x, p.y, p.z}));
-    std::vector<bool> used(a->mNumVertices);
-    for (unsigned f = 0; f < a->mNumFaces; ++f)
-      for (unsigned i = 0; i < a->mFaces[f].mNumIndices; ++i)
-        if (a->mFaces[f].mIndices[i] < a->mNumVertices) used[a->mFaces[f].mIndices[i]] = true;
-    unused += std::count(used.begin(), used.end(), false);
   }
+  // Positions no face uses are left out below: counted here, an object at a time.
+  std::int64_t unused = 0;
+  for_each_object(*scene, [&](const aiNode& object) { unused += unused_positions(*scene, object); });
   if (unused) notes.push_back("dropped " + std::to_string(unused) + " unreferenced vertices");
   scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
                                        aiProcess_PreTransformVertices | aiProcess_SortByPType |
@@ -139,6 +167,11 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   if (!scene) refused_by_assimp(path, importer);
   Mesh m;
   std::int64_t points = 0, lines = 0;
+  std::vector<const aiNode*> object(scene->mNumMeshes, scene->mRootNode);  // each mesh's
+  for_each_object(*scene, [&](const aiNode& n) {
+    for (unsigned k = 0; k < n.mNumMeshes; ++k) object[n.mMeshes[k]] = &n;
+  });
+  std::unordered_map<const aiNode*, PositionIndex> joined;  // each object's positions
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
     if (!(a->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {  // points or lines (SortByPType): no nodes
@@ -147,7 +180,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
     }
     if (std::int64_t(m.position.size()) + a->mNumVertices > (std::int64_t(1) << 30))
       bad(path, "more than 2^30 vertices");
-    const std::vector<std::int32_t> vertex = join_identical_vertices(*a, m.position);
+    const std::vector<std::int32_t> vertex = join_identical_vertices(*a, joined[object[k]], m.position);
     for (unsigned f = 0; f < a->mNumFaces; ++f) {
       const aiFace& face = a->mFaces[f];
       m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});

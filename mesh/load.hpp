@@ -18,9 +18,10 @@ struct WriteError : std::invalid_argument {
 // Reads a mesh as its library gives it (Gmsh: .msh, nodes in Gmsh's order; assimp: everything
 // else, vertices in the order assimp delivers them: for OBJ, the order in which faces first use
 // them). Polygons are split into triangles; vertices at one position (bit for bit, 0 and -0
-// alike) within an object of the file are joined (OBJ and STL repeat a vertex per face), and
-// those shared between objects are left for repair() to weld and count. Vertices no face uses,
-// points and lines are left out and counted in `notes`.
+// alike) within an object of the file (a node of its scene graph, all its materials' and
+// primitives' meshes) are joined (OBJ and STL repeat a vertex per face), and those shared
+// between objects are left for repair() to weld and count. Positions no face of their object
+// uses, points and lines are left out and counted in `notes`.
 // Throws std::invalid_argument naming the file and the problem.
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 

@@ -111,6 +111,28 @@ TEST_F(MeshFile, ALineLeftOutAddsNoNodes) {
   EXPECT_TRUE(repair(m).empty());
 }
 
+// An object split by assimp (an OBJ's materials, a glTF mesh's primitives over one accessor)
+// is one object: its vertices are joined, not welded, and none of them is unreferenced.
+TEST_F(MeshFile, AnObjectSplitByMaterialOrPrimitiveIsOneObject) {
+  Mesh obj = load(write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 2 4 3\n"));
+  EXPECT_EQ(obj.position.size(), 4u);
+  EXPECT_TRUE(notes_.empty());
+  EXPECT_TRUE(repair(obj).empty());
+  Mesh gltf = load(write("p.gltf", R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1},
+                                                       {"attributes": {"POSITION": 0}, "indices": 2}]}],
+    "buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwAAgD8AAAAAAAABAAIAAQADAAIA",
+                 "byteLength": 60}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "byteOffset": 0, "componentType": 5123, "count": 3, "type": "SCALAR"},
+                  {"bufferView": 1, "byteOffset": 6, "componentType": 5123, "count": 3, "type": "SCALAR"}]})"));
+  EXPECT_EQ(gltf.position.size(), 4u);
+  EXPECT_EQ(gltf.triangle.size(), 2u);
+  EXPECT_TRUE(notes_.empty()) << notes_.front();
+  EXPECT_TRUE(repair(gltf).empty());
+}
+
 TEST_F(MeshFile, PlyStlAndGltfGiveTheObjsMesh) {
   // The same closed surface (a tetrahedron) exported by assimp in each format, read back.
   const std::string obj = write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
