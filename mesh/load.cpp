@@ -1,6 +1,8 @@
 #include "load.hpp"
 
 #include <assimp/DefaultIOSystem.h>
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/LogStream.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -135,7 +137,31 @@ std::int64_t unused_positions(const aiScene& scene, const aiNode& object) {
   return std::int64_t(all.size() - used.size());
 }
 
+// assimp reads on past some faults of a file, and says so only in its log: it clamps an OFF
+// face's index out of range, and drops a glTF's faces with one or its vertices beyond a whole
+// triangle. The first such line of its log (an index "out of range" or what "were dropped")
+// while it reads, kept to refuse the file with.
+class DataLost : public Assimp::LogStream {
+ public:
+  DataLost() {
+    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+    Assimp::DefaultLogger::get()->attachStream(this, Assimp::Logger::Warn | Assimp::Logger::Err);
+  }
+  ~DataLost() override {
+    Assimp::DefaultLogger::get()->detachStream(this, Assimp::Logger::Warn | Assimp::Logger::Err);
+    Assimp::DefaultLogger::kill();
+  }
+  void write(const char* message) override {
+    const std::string m = message;
+    if (first.empty() && (m.find("out of range") != std::string::npos || m.find("out-of-range") != std::string::npos ||
+                          m.find("were dropped") != std::string::npos))
+      first = m.substr(m.find(": ") == std::string::npos ? 0 : m.find(": ") + 2);
+  }
+  std::string first;  // without assimp's "Warn, T0: " and its line end
+};
+
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
+  DataLost lost;
   Assimp::Importer importer;
   require_ply_header_end(path, importer);
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
@@ -152,6 +178,10 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   // too, then processed.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
   if (!scene) refused_by_assimp(path, importer);
+  if (!lost.first.empty()) {
+    while (!lost.first.empty() && std::isspace(static_cast<unsigned char>(lost.first.back()))) lost.first.pop_back();
+    bad(path, "assimp: " + lost.first);
+  }
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
     for (unsigned v = 0; v < a->mNumVertices; ++v)

@@ -289,6 +289,9 @@ const std::vector<BadInput>& cases() {
            "m.ply"),
       mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            "ply\nformat ascii 1.0\n", "m.ply"),
+      // assimp clamps an OFF face's index out of range and says so only in its log.
+      mesh("mesh_off_index_out_of_range", "{\"file\": \"m.off\"}", "m.off': assimp: OFF: Vertex index is out of range",
+           "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 9 2\n", "m.off"),
       // Read as PLY for its content where assimp knows no reader for its extension.
       mesh("mesh_ply_truncated_header_unnamed", "{\"file\": \"m.dat\"}",
            "m.dat': its PLY header has no end_header line", "ply\nformat ascii 1.0\nelement vertex 3\nprop", "m.dat"),

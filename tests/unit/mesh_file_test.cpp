@@ -180,6 +180,15 @@ TEST_F(MeshFile, BrokenFilesAreRefusedWithTheFileName) {
   std::string stl(80, ' ');
   stl += std::string("\x0c\0\0\0", 4) + std::string(50, '\0');  // 12 triangles announced, one there
   EXPECT_EQ(error("cut.stl", stl).rfind(at + "cut.stl': ", 0), 0u);
+  // A glTF face with an index out of range: assimp drops it and says so only in its log.
+  EXPECT_EQ(error("oor.gltf", R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    "buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwAAgD8AAAAAAAABAAIAAQADAAkA",
+                 "byteLength": 60}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}]})"),
+            at + "oor.gltf': assimp: Some faces had out-of-range indices. Those faces were dropped.");
   EXPECT_EQ(error("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "accepted");
 }
 
