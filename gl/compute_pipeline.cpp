@@ -19,15 +19,15 @@ class ComputePipeline final : public GlPipeline {
  public:
   ComputePipeline(const PipelineSetup& s, const SharedAllocator& shared, const CudaMemory& cuda = {})
       : GlPipeline(s, shared ? "hybrid-compute" : "glsl-compute", shared, cuda) {
-    // step.comp's blocks: bindings 0-7, the stop-rule words (9), the posted word (10) and, with an
-    // outside force stage, its accelerations (8).
+    // step.comp's blocks: bindings 0-6, the stop-rule words (8), the posted word (9) and, with an
+    // outside force stage, its accelerations (7).
     GLint blocks = 0, bindings = 0;
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
     glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &bindings);
-    const int need = shared ? 11 : 10;
-    if (blocks < need || bindings < 11)
+    const int need = shared ? 10 : 9;
+    if (blocks < need || bindings < 10)
       throw std::invalid_argument(name_ + " needs " + std::to_string(need) +
-                                  " storage buffers per compute shader and 11 storage buffer bindings");
+                                  " storage buffers per compute shader and 10 storage buffer bindings");
     for (GLuint d = 0; d < 3; ++d) glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, d, &max_groups_[d]);
     for (const NodeWindow& w : windows_) {
       const auto g = work_groups(w).groups;

@@ -15,6 +15,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
@@ -49,17 +50,17 @@ std::string extension_of(const std::string& path) {
 
 // assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
 // file is refused first (the header is text, within its first 64 KiB in any file we know). A
-// file is read as PLY by its extension or, where assimp knows no reader for its extension,
-// when "ply" is in its first 200 bytes (assimp's own test).
+// file is taken for PLY by its extension or, where assimp knows no reader for its extension,
+// by PLY's magic word at its start (a file that only holds "ply" further on fails assimp's
+// PLY reader at once).
 void require_ply_header_end(const std::string& path, const Assimp::Importer& importer) {
   std::ifstream in(path, std::ios::binary);
   std::string head(64 * 1024, '\0');
   in.read(head.data(), std::streamsize(head.size()));
   head.resize(std::size_t(in.gcount()));
   const std::string ext = extension_of(path);
-  std::string start = head.substr(0, 200);
-  for (char& c : start) c = char(std::tolower(static_cast<unsigned char>(c)));
-  const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && start.find("ply") != std::string::npos);
+  const bool magic = head.starts_with("ply") || head.starts_with("PLY");
+  const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
   if (ply && head.find("end_header") == std::string::npos)
     bad(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
@@ -139,8 +140,9 @@ std::int64_t unused_positions(const aiScene& scene, const aiNode& object) {
 
 // assimp reads on past some faults of a file, and says so only in its log: it clamps an OFF
 // face's index out of range, and drops a glTF's faces with one or its vertices beyond a whole
-// triangle. The first such line of its log (an index "out of range" or what "were dropped")
-// while it reads, kept to refuse the file with.
+// triangle. The first of those lines of its log while it reads, kept to refuse the file with
+// (other lines that say "out of range" or "dropped" are of what is not read: materials,
+// colours, lines).
 class DataLost : public Assimp::LogStream {
  public:
   DataLost() {
@@ -153,8 +155,9 @@ class DataLost : public Assimp::LogStream {
   }
   void write(const char* message) override {
     const std::string m = message;
-    if (first.empty() && (m.find("out of range") != std::string::npos || m.find("out-of-range") != std::string::npos ||
-                          m.find("were dropped") != std::string::npos))
+    if (first.empty() && (m.find("Vertex index is out of range") != std::string::npos ||
+                          m.find("faces had out-of-range indices") != std::string::npos ||
+                          m.find("not compatible with the TRIANGLES mode") != std::string::npos))
       first = m.substr(m.find(": ") == std::string::npos ? 0 : m.find(": ") + 2);
   }
   std::string first;  // without assimp's "Warn, T0: " and its line end
@@ -208,9 +211,10 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
       for (unsigned f = 0; f < a->mNumFaces; ++f) ++(a->mFaces[f].mNumIndices == 2 ? lines : points);
       continue;
     }
-    if (std::int64_t(m.position.size()) + a->mNumVertices > (std::int64_t(1) << 30))
-      bad(path, "more than 2^30 vertices");
+    if (std::int64_t(m.position.size()) + a->mNumVertices > std::numeric_limits<std::int32_t>::max())
+      bad(path, "more than 2^31 vertices before joining those at one position");
     const std::vector<std::int32_t> vertex = join_identical_vertices(*a, joined[object[k]], m.position);
+    if (m.position.size() > (std::size_t(1) << 30)) bad(path, "more than 2^30 vertices");
     for (unsigned f = 0; f < a->mNumFaces; ++f) {
       const aiFace& face = a->mFaces[f];
       m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});

@@ -128,9 +128,9 @@ TEST(CudaTemporal, FindsANonFiniteState) {
   }
 }
 
-// A launch taken back (the run loop's lagged checks) leaves the state before it, previous
-// positions included (Verlet keeps them in their own ping-pong buffers), and the launches
-// after it go on as if it had not been; a launch still held, or one taken back, cannot be.
+// A launch taken back (the run loop's lagged checks) leaves the state before it, Verlet's
+// half_step included, and the launches after it go on as if it had not been; a launch still
+// held, or one taken back, cannot be.
 TEST(CudaTemporal, TakesTheLastLaunchBack) {
   DEFORMLAB_REQUIRE_CUDA();
   const ContactScene sc = contact_scene(small_cloth(37, 53), false);

@@ -49,7 +49,7 @@ TEST(ViewerSession, ReplacedPipelineContinuesTheTrajectory) {
   EXPECT_NEAR(s.time(), 10 * 0.001 + 15 * 0.002, 1e-8);
 }
 
-TEST(ViewerSession, VerletKeepsItsPreviousPositionsOnlyAtItsOwnStep) {
+TEST(ViewerSession, VerletKeepsItsHalfStepVelocityOnlyAtItsOwnStep) {
   const Integrator verlet = Integrator::verlet;
   Session s = cloth_session("cpu", 12, verlet), plain = cloth_session("cpu", 12, verlet);
   s.step(10);
