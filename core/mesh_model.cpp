@@ -106,6 +106,22 @@ std::string non_finite_vertex(const Vec3f& p) {
   return os.str();
 }
 
+std::vector<std::int32_t> first_at_same_position(const std::vector<Vec3f>& position) {
+  const std::int64_t n = std::int64_t(position.size());
+  std::vector<std::int32_t> by_position(n), first(n);
+  std::iota(by_position.begin(), by_position.end(), 0);
+  auto less = [&](std::int32_t a, std::int32_t b) {
+    const Vec3f &p = position[a], &q = position[b];
+    return std::tie(p.x, p.y, p.z, a) < std::tie(q.x, q.y, q.z, b);
+  };
+  __gnu_parallel::sort(by_position.begin(), by_position.end(), less);
+  for (std::int64_t k = 0; k < n; ++k) {
+    const std::int32_t v = by_position[k];
+    first[v] = k > 0 && position[v] == position[by_position[k - 1]] ? first[by_position[k - 1]] : v;
+  }
+  return first;
+}
+
 std::vector<std::string> repair(Mesh& m) {
   const std::int64_t n = std::int64_t(m.position.size());
   if (m.triangle.empty() && m.tetrahedron.empty()) bad("the mesh has no triangles or tetrahedra");
@@ -122,20 +138,9 @@ std::vector<std::string> repair(Mesh& m) {
   });
 
   // Weld vertices at identical positions onto the first of them.
-  std::vector<std::int32_t> by_position(n), remap(n);
-  std::iota(by_position.begin(), by_position.end(), 0);
-  auto less = [&](std::int32_t a, std::int32_t b) {
-    const Vec3f &p = m.position[a], &q = m.position[b];
-    return std::tie(p.x, p.y, p.z, a) < std::tie(q.x, q.y, q.z, b);
-  };
-  __gnu_parallel::sort(by_position.begin(), by_position.end(), less);
+  std::vector<std::int32_t> remap = first_at_same_position(m.position);
   std::int64_t welded = 0;
-  for (std::int64_t k = 0; k < n; ++k) {
-    const std::int32_t v = by_position[k];
-    const bool same = k > 0 && m.position[v] == m.position[by_position[k - 1]];
-    remap[v] = same ? remap[by_position[k - 1]] : v;
-    welded += same;
-  }
+  for (std::int64_t v = 0; v < n; ++v) welded += remap[v] != v;
   // Drop what no element uses (welded duplicates among them); the rest keep their order.
   std::vector<std::int32_t> used(n, 0);
   for_each_index(m, [&](std::int32_t& v) { v = remap[v]; used[v] = 1; });

@@ -36,6 +36,10 @@ struct Mesh {
 // face shared by more than two tetrahedra.
 std::vector<std::string> repair(Mesh& m);
 
+// For each vertex, the first vertex at its position (itself where none comes before it);
+// 0 and -0 are one position.
+std::vector<std::int32_t> first_at_same_position(const std::vector<Vec3f>& position);
+
 // Whether some tetrahedron has zero volume (as repair finds it), four vertices in a plane.
 bool has_flat_tetrahedron(const Mesh& m);
 

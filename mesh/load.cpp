@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -82,18 +81,6 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   }
 };
 
-// A vertex's position as its bits, -0 taken for 0: positions are joined where these are equal.
-using PositionBits = std::array<std::uint32_t, 3>;
-PositionBits position_bits(const aiVector3D& p) {
-  return std::bit_cast<PositionBits>(Vec3f{p.x + 0.f, p.y + 0.f, p.z + 0.f});
-}
-struct HashBits {
-  std::size_t operator()(const PositionBits& b) const {
-    return std::hash<std::uint64_t>{}((std::uint64_t(b[0]) << 32 | b[1]) ^ (std::uint64_t(b[2]) * 0x9e3779b97f4a7c15u));
-  }
-};
-using PositionIndex = std::unordered_map<PositionBits, std::int32_t, HashBits>;
-
 // f(node) for each node of the file's scene graph: its objects. assimp splits an object into a
 // mesh per material (OBJ) or per primitive (glTF), all of them under its node.
 template <class F>
@@ -107,35 +94,80 @@ void for_each_object(const aiScene& scene, F f) {
   }
 }
 
-// Appends the vertices of `a` that its faces use to `position`, those at a position already in
-// `first` (its object's, as this object's meshes add them) or repeated in `a` once, in the
-// order of their first index; returns the index in `position` of each of a's vertices.
-// (assimp's own aiProcess_JoinIdenticalVertices also joins vertices within about 1e-5 of a
-// file unit, which would turn a fine mesh's small triangles into degenerate ones.)
-std::vector<std::int32_t> join_identical_vertices(const aiMesh& a, PositionIndex& first, std::vector<Vec3f>& position) {
-  std::vector<std::int32_t> vertex(a.mNumVertices, -1);
-  for (unsigned f = 0; f < a.mNumFaces; ++f)
-    for (unsigned i = 0; i < a.mFaces[f].mNumIndices; ++i) vertex[a.mFaces[f].mIndices[i]] = 0;
-  for (unsigned v = 0; v < a.mNumVertices; ++v) {
-    if (vertex[v] < 0) continue;
-    const auto [at, fresh] = first.try_emplace(position_bits(a.mVertices[v]), std::int32_t(position.size()));
-    if (fresh) position.push_back(std::bit_cast<Vec3f>(at->first));
-    vertex[v] = at->second;
-  }
-  return vertex;
+Vec3f position_of(const aiVector3D& p) { return {p.x, p.y, p.z}; }
+
+std::int64_t distinct_positions(const std::vector<Vec3f>& p) {
+  const std::vector<std::int32_t> first = first_at_same_position(p);
+  std::int64_t n = 0;
+  for (std::size_t v = 0; v < p.size(); ++v) n += first[v] == std::int32_t(v);
+  return n;
 }
 
-// The positions of an object's vertices that no face of it uses, over its meshes.
+// The positions of an object's vertices that no face of it uses, over its meshes (none, at
+// once, where every vertex is used).
 std::int64_t unused_positions(const aiScene& scene, const aiNode& object) {
-  std::unordered_set<PositionBits, HashBits> all, used;
+  std::vector<Vec3f> all, used;
+  bool some_unused = false;
   for (unsigned k = 0; k < object.mNumMeshes; ++k) {
     const aiMesh& a = *scene.mMeshes[object.mMeshes[k]];
-    for (unsigned v = 0; v < a.mNumVertices; ++v) all.insert(position_bits(a.mVertices[v]));
+    std::vector<char> is_used(a.mNumVertices);
     for (unsigned f = 0; f < a.mNumFaces; ++f)
       for (unsigned i = 0; i < a.mFaces[f].mNumIndices; ++i)
-        if (a.mFaces[f].mIndices[i] < a.mNumVertices) used.insert(position_bits(a.mVertices[a.mFaces[f].mIndices[i]]));
+        if (a.mFaces[f].mIndices[i] < a.mNumVertices) is_used[a.mFaces[f].mIndices[i]] = 1;
+    for (unsigned v = 0; v < a.mNumVertices; ++v) {
+      all.push_back(position_of(a.mVertices[v]));
+      if (is_used[v]) used.push_back(all.back());
+      some_unused |= !is_used[v];
+    }
   }
-  return std::int64_t(all.size() - used.size());
+  return some_unused ? distinct_positions(all) - distinct_positions(used) : 0;
+}
+
+// Appends the triangles of an object's meshes to `m` with the vertices they use, those at one
+// position once (0 and -0 as 0), in the order of its meshes and their first indices; counts
+// the points and lines left out. (assimp's own aiProcess_JoinIdenticalVertices also joins
+// vertices within about 1e-5 of a file unit, which turns a fine mesh's small triangles into
+// degenerate ones.)
+void append_object(const std::string& path, const aiScene& scene, const aiNode& object, Mesh& m,
+                   std::int64_t& points, std::int64_t& lines) {
+  std::vector<Vec3f> p;
+  std::vector<std::vector<std::int32_t>> at(object.mNumMeshes);  // each mesh vertex's place in p
+  for (unsigned k = 0; k < object.mNumMeshes; ++k) {
+    const aiMesh& a = *scene.mMeshes[object.mMeshes[k]];
+    if (!(a.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {  // points or lines (SortByPType): no nodes
+      for (unsigned f = 0; f < a.mNumFaces; ++f) ++(a.mFaces[f].mNumIndices == 2 ? lines : points);
+      continue;
+    }
+    if (std::int64_t(p.size()) + a.mNumVertices > std::numeric_limits<std::int32_t>::max())
+      bad(path, "more than 2^31 vertices before joining those at one position");
+    at[k].assign(a.mNumVertices, -1);
+    for (unsigned f = 0; f < a.mNumFaces; ++f)
+      for (unsigned i = 0; i < 3; ++i) at[k][a.mFaces[f].mIndices[i]] = 0;
+    for (unsigned v = 0; v < a.mNumVertices; ++v)
+      if (at[k][v] == 0) {
+        at[k][v] = std::int32_t(p.size());
+        p.push_back(position_of(a.mVertices[v]) + Vec3f{});  // -0 + 0 is 0
+      }
+  }
+  const std::vector<std::int32_t> first = first_at_same_position(p);
+  std::vector<std::int32_t> node(p.size());
+  for (std::size_t e = 0; e < p.size(); ++e) {
+    if (first[e] != std::int32_t(e)) {
+      node[e] = node[std::size_t(first[e])];
+    } else {
+      node[e] = std::int32_t(m.position.size());
+      m.position.push_back(p[e]);
+    }
+  }
+  if (m.position.size() > (std::size_t(1) << 30)) bad(path, "more than 2^30 vertices");
+  for (unsigned k = 0; k < object.mNumMeshes; ++k) {
+    const aiMesh& a = *scene.mMeshes[object.mMeshes[k]];
+    if (at[k].empty()) continue;
+    for (unsigned f = 0; f < a.mNumFaces; ++f) {
+      auto corner = [&](int c) { return node[std::size_t(at[k][a.mFaces[f].mIndices[c]])]; };
+      m.triangle.push_back({corner(0), corner(1), corner(2)});
+    }
+  }
 }
 
 // assimp reads on past some faults of a file, and says so only in its log: it clamps an OFF
@@ -200,26 +232,14 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   if (!scene) refused_by_assimp(path, importer);
   Mesh m;
   std::int64_t points = 0, lines = 0;
+  // Objects in the order of their first meshes.
   std::vector<const aiNode*> object(scene->mNumMeshes, scene->mRootNode);  // each mesh's
   for_each_object(*scene, [&](const aiNode& n) {
     for (unsigned k = 0; k < n.mNumMeshes; ++k) object[n.mMeshes[k]] = &n;
   });
-  std::unordered_map<const aiNode*, PositionIndex> joined;  // each object's positions
-  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
-    const aiMesh* a = scene->mMeshes[k];
-    if (!(a->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {  // points or lines (SortByPType): no nodes
-      for (unsigned f = 0; f < a->mNumFaces; ++f) ++(a->mFaces[f].mNumIndices == 2 ? lines : points);
-      continue;
-    }
-    if (std::int64_t(m.position.size()) + a->mNumVertices > std::numeric_limits<std::int32_t>::max())
-      bad(path, "more than 2^31 vertices before joining those at one position");
-    const std::vector<std::int32_t> vertex = join_identical_vertices(*a, joined[object[k]], m.position);
-    if (m.position.size() > (std::size_t(1) << 30)) bad(path, "more than 2^30 vertices");
-    for (unsigned f = 0; f < a->mNumFaces; ++f) {
-      const aiFace& face = a->mFaces[f];
-      m.triangle.push_back({vertex[face.mIndices[0]], vertex[face.mIndices[1]], vertex[face.mIndices[2]]});
-    }
-  }
+  std::unordered_set<const aiNode*> appended;
+  for (const aiNode* o : object)
+    if (appended.insert(o).second) append_object(path, *scene, *o, m, points, lines);
   if (points || lines)
     notes.push_back("left out " + std::to_string(points) + " points and " + std::to_string(lines) + " lines");
   if (m.triangle.empty()) bad(path, "no triangles");

@@ -2,8 +2,8 @@
 // glsl-compute's bare gather: step.comp's loads and stores on an n x n cloth (its work groups,
 // its stencil, the fast build's unrolled loops) without its arithmetic. Each invocation reads its
 // node's x and v and its neighbours' x and v (step.comp reads them for every spring), and
-// writes them back with the neighbours' components summed in, so that no load is dead. Defines: TILE_X, TILE_Y, STENCIL_SIZE,
-// STENCIL_OFFSETS.
+// writes them back with the neighbours' components summed in, so that no load is dead.
+// Defines: TILE_X, TILE_Y, STENCIL_SIZE, STENCIL_OFFSETS.
 layout(local_size_x = TILE_X, local_size_y = TILE_Y) in;
 layout(std430, binding = 0) readonly buffer X { vec4 x[]; };
 layout(std430, binding = 1) readonly buffer V { vec4 v[]; };
