@@ -56,7 +56,7 @@ int experiment_command(const ExperimentArgs& a) {
   }
   return report_errors([&] {
     if (!a.report_only) {  // builds the models: out of memory is bad input
-      require_model_files(x, *sweep, a.file);
+      require_model_files(x, *sweep);
       require_size_scenes(x, *sweep, a.file);
     }
     if (a.report_only && !calibration.is_null()) {

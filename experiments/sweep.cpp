@@ -78,6 +78,7 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
   const std::string w = where + ".sweep";
   if (!j.is_object()) bad_value(w, "expected an object");
   Sweep s;
+  s.where = where;
   // The experiment's model type, a base's written in (experiments/experiment.cpp).
   const json* model = x.contains("scene") && x["scene"].is_object() && x["scene"].contains("model")
                           ? &x["scene"]["model"]

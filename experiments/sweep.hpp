@@ -43,6 +43,7 @@ struct Sweep {
   std::string time = "update";                // "update", or "frame": update + render
   std::string paper_table;                    // "table1", "table2", "table3" or "" (report)
   int frames = 4;                             // frames of the experiment's scene for the report (0: none)
+  std::string where;                          // the experiment as named (file or built-in): errors' key paths
 };
 
 struct Cell {
@@ -120,7 +121,9 @@ class ModelCache {
 // One cell's result: {"status": "ok", "median_ms", ..., "stages": [{"name", "median_ms",
 // "clock", "per_step"}] for pipelines that time their stages} or {"status": "n/a", "reason"};
 // "nodes", "springs", "model_build_s" (0: a model built for an earlier cell) and, for mesh
-// models, "model", "order", "mesh" ("surface" or "volume") and "bandwidth".
+// models, "model", "order", "mesh" ("surface" or "volume") and "bandwidth". Throws
+// std::invalid_argument where the cell's model or scene is bad input (a model generated or
+// filled, or a grid over kCheckedNodes, is built and checked only here): the sweep stops.
 nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
 
 // Frames of the experiment's own scene (its model, not a sweep size) on the best pipeline

@@ -221,19 +221,25 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
   const Integrator integ = *parse_integrator(c.integrator);
   if (auto why = e.unavailable(); !why.empty()) return not_applicable(r, why);
   if (auto why = e.unsupported(integ); !why.empty()) return not_applicable(r, why);
-  try {
-    Scene scene = c.model.empty() ? x.scene : model_cell_scene(x, s, c);
-    if (c.model.empty())
-      if (auto why = size_grid(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
+  Scene scene = c.model.empty() ? x.scene : model_cell_scene(x, s, c);
+  if (c.model.empty())
+    if (auto why = size_grid(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
+  const Model* m = nullptr;
+  Params p;
+  try {  // std::invalid_argument goes on: the scene is bad input, whatever the pipeline
     const int built = cache.models_built();
     const auto t0 = clock::now();
-    const Model& m = cache.model(scene, c);
+    m = &cache.model(scene, c);
     r["model_build_s"] = cache.models_built() == built ? 0.0 : std::chrono::duration<double>(clock::now() - t0).count();
-    if (!c.model.empty())
-      if (auto why = record_mesh(m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
-    const Params p = resolve_params(scene, m);
-    auto pipe = e.make({m, p, integ, c.options});
-    return measure(r, *pipe, m, s, e);
+    p = resolve_params(scene, *m);
+  } catch (const std::bad_alloc&) {
+    return not_applicable(r, "does not fit: out of host memory");
+  }
+  if (!c.model.empty())
+    if (auto why = record_mesh(*m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
+  try {
+    auto pipe = e.make({*m, p, integ, c.options});
+    return measure(r, *pipe, *m, s, e);
   } catch (const std::invalid_argument& ex) {
     return not_applicable(r, ex.what());
   } catch (const std::bad_alloc&) {

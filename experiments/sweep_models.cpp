@@ -24,6 +24,9 @@ Scene model_scene(const Experiment& x, const Sweep& s, const json& m, const std:
   return scene;
 }
 
+// The key path of the sweep's model k, for errors.
+std::string model_key(const Sweep& s, std::size_t k) { return s.where + ".sweep.models[" + std::to_string(k) + "]"; }
+
 }  // namespace
 
 std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& where) {
@@ -79,9 +82,9 @@ void check_models_under_orders(const Sweep& s, const std::string& where) {
   }
 }
 
-void require_model_files(const Experiment& x, const Sweep& s, const std::string& where) {
+void require_model_files(const Experiment& x, const Sweep& s) {
   for (std::size_t k = 0; k < s.models.size(); ++k) {
-    const std::string at = where + ".sweep.models[" + std::to_string(k) + "]", w = at + ".model";
+    const std::string at = model_key(s, k), w = at + ".model";
     Scene scene = model_scene(x, s, s.models[k].model, at);
     std::error_code ec;
     const std::string& file = scene.model.mesh.file;
@@ -94,7 +97,7 @@ void require_model_files(const Experiment& x, const Sweep& s, const std::string&
 
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {
   const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == c.model; });
-  Scene scene = model_scene(x, s, m->model, "sweep.models." + c.model);
+  Scene scene = model_scene(x, s, m->model, model_key(s, std::size_t(m - s.models.begin())));
   if (!c.order.empty()) scene.model.mesh.order = *parse_node_order(c.order);
   return scene;
 }

@@ -19,9 +19,9 @@ std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::
 void check_models_under_orders(const Sweep& s, const std::string& where);
 
 // Throws std::invalid_argument naming the first model whose mesh file is missing or cannot be
-// read and repaired (check_mesh_file; relative files from the experiment's folder; `where`
-// names the experiment file in the message): checked before the first cell runs.
-void require_model_files(const Experiment& x, const Sweep& s, const std::string& where);
+// read and repaired (check_mesh_file; relative files from the experiment's folder): checked
+// before the first cell runs. A model generated or filled is checked at its first cell.
+void require_model_files(const Experiment& x, const Sweep& s);
 
 // The experiment's scene with a model cell's model (relative files from the experiment's
 // folder) and order.

@@ -1,5 +1,5 @@
 // `deformlab experiment` end to end: results folders it finds damaged or in the way, mesh sweeps,
-// and frames that do not fit the host.
+// a model found bad at its first cell, and frames that do not fit the host.
 #include <nlohmann/json.hpp>
 #include <fstream>
 #include <string>
@@ -110,6 +110,23 @@ TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
   std::ofstream(cell) << no_springs.dump();
   EXPECT_NE(run(experiment + " --report-only").err.find("is not a cell result (its \"springs\" is missing)"),
             std::string::npos);
+}
+
+// A generated or filled model is built only for its cells: one whose pins pick no node of it
+// stops the experiment at its first cell with one line and exit 2, keeping the cells before.
+TEST_F(Cli, AFilledModelWhosePinsPickNothingStopsTheExperiment) {
+  write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  write("x.json", R"({"name": "filled", "scene": {"model": {"type": "mesh", "file": "t.obj", "pins": "none"}, "drag": null},
+      "sweep": {"models": [{"name": "a", "model": {"pins": "none"}},
+                           {"name": "b", "model": {"fill": "tetrahedra", "cell_size": 0.3,
+                                                   "pins": [{"box": [[5, 5, 5], [6, 6, 6]]}]}}],
+                "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})");
+  const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "deformlab: error: " + (dir_ / "x.json").string() +
+                       ".sweep.models[1].model.pins[0]: the box holds no node of the model\n");
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__a.json"))["status"], "ok");
+  EXPECT_FALSE(fs::exists(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__b.json"));
 }
 
 // An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (40 GiB on a
