@@ -37,6 +37,9 @@ namespace {
   std::string why;
   for (const char* c = importer.GetErrorString(); *c; ++c)
     if (!(*c == ' ' && !why.empty() && why.back() == ' ')) why += *c;
+  // assimp's words for an OBJ `f` line of one or two vertices among an object's polygons.
+  if (why.find("is a LINE but") != std::string::npos || why.find("is a POINT but") != std::string::npos)
+    why += " (a face of fewer than 3 vertices among polygons: an OBJ writes lines with `l`, points with `p`)";
   bad(file, "assimp: " + why);
 }
 

@@ -312,6 +312,10 @@ const std::vector<BadInput>& cases() {
       mesh("mesh_no_faces", "{\"file\": \"m.obj\"}", "m.obj': assimp: Validation failed: Mesh contains no faces",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
       mesh("mesh_lines_only", "{\"file\": \"m.obj\"}", "m.obj': no triangles", "v 0 0 0\nv 1 0 0\nl 1 2\n"),
+      mesh("mesh_obj_two_vertex_face", "{\"file\": \"m.obj\"}",
+           "m.obj': assimp: Validation failed: aiMesh::mFaces[1] is a LINE but aiMesh::mPrimitiveTypes does not report "
+           "the LINE flag (a face of fewer than 3 vertices among polygons: an OBJ writes lines with `l`, points with `p`)",
+           "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"),
       mesh("mesh_fill_open", "{\"file\": \"m.obj\", \"fill\": \"tetrahedra\"}",
            "Gmsh made no tetrahedra (is the surface closed?)"),
       mesh("mesh_fill_too_fine", "{\"file\": \"t.obj\", \"fill\": \"tetrahedra\", \"cell_size\": 0.00001}",
