@@ -22,6 +22,7 @@
 
 #include "child_read.hpp"
 #include "gmsh_session.hpp"
+#include "read_guards.hpp"
 
 namespace deformlab {
 
@@ -41,30 +42,6 @@ namespace {
   if (why.find("is a LINE but") != std::string::npos || why.find("is a POINT but") != std::string::npos)
     why += " (a face of fewer than 3 vertices among polygons: an OBJ writes lines with `l`, points with `p`)";
   bad(file, "assimp: " + why);
-}
-
-// A file name's extension in lower case (".PLY" and ".ply" name one format).
-std::string extension_of(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-// assimp's PLY reader loops for ever on a header cut off before its end_header line: such a
-// file is refused first (the header is text, within its first 64 KiB in any file we know). A
-// file is taken for PLY by its extension or, where assimp knows no reader for its extension,
-// by PLY's magic word at its start (a file that only holds "ply" further on fails assimp's
-// PLY reader at once).
-void require_ply_header_end(const std::string& path, const Assimp::Importer& importer) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(64 * 1024, '\0');
-  in.read(head.data(), std::streamsize(head.size()));
-  head.resize(std::size_t(in.gcount()));
-  const std::string ext = extension_of(path);
-  const bool magic = head.starts_with("ply") || head.starts_with("PLY");
-  const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
-  if (ply && head.find("end_header") == std::string::npos)
-    bad(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
 
 // assimp also opens the files a mesh names (an OBJ's mtllib, a glTF's buffers): regular files
@@ -202,6 +179,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   DataLost lost;
   Assimp::Importer importer;
   require_ply_header_end(path, importer);
+  require_obj_lines_read(path);
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
   // Positions only: the other components are dropped before the other steps.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
@@ -432,6 +410,10 @@ Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& sa
       std::string error;
       gmsh::logger::getLastError(error);
       if (error.find("No elements in volume") != std::string::npos) throw std::invalid_argument(none);
+      // TetGen's boundary recovery: its message ends before the point it names.
+      if (error.find("PLC Error") != std::string::npos)
+        throw std::invalid_argument(error + " (the surface crosses itself: a fill takes a closed surface whose "
+                                            "triangles meet only at shared edges)");
       throw;
     }
     m = read_gmsh_model("filling the surface with tetrahedra");

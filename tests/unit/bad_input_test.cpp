@@ -316,8 +316,20 @@ const std::vector<BadInput>& cases() {
            "m.obj': assimp: Validation failed: aiMesh::mFaces[1] is a LINE but aiMesh::mPrimitiveTypes does not report "
            "the LINE flag (a face of fewer than 3 vertices among polygons: an OBJ writes lines with `l`, points with `p`)",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"),
+      mesh("mesh_obj_vertex_skipped", "{\"file\": \"m.obj\"}",
+           "m.obj': line 2: a vertex of 2 numbers, which assimp's OBJ reader skips (it keeps 3, 4 or 6, counting the "
+           "words that start with a digit, + or -: write .5 as 0.5)",
+           "v 0 0 0\nv .5 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),
+      mesh("mesh_obj_face_indented", "{\"file\": \"m.obj\"}",
+           "m.obj': line 6: an indented `f` line, which assimp's OBJ reader skips",
+           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n\t f 2 4 3\n"),
       mesh("mesh_fill_open", "{\"file\": \"m.obj\", \"fill\": \"tetrahedra\"}",
            "Gmsh made no tetrahedra (is the surface closed?)"),
+      mesh("mesh_fill_self_crossing", "{\"file\": \"x.obj\", \"fill\": \"tetrahedra\", \"cell_size\": 0.2}",
+           "x.obj': PLC Error:  A segment and a facet intersect at point (the surface crosses itself: a fill takes a "
+           "closed surface whose triangles meet only at shared edges)",
+           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0.2 0.2 0.2\nv 1.2 0.2 0.2\nv 0.2 1.2 0.2\nv 0.2 0.2 1.2\n"
+           "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n", "x.obj"),
       mesh("mesh_fill_too_fine", "{\"file\": \"t.obj\", \"fill\": \"tetrahedra\", \"cell_size\": 0.00001}",
            "filling with tetrahedra of cell_size 1e-05 m would make about 1e+14 nodes, over the limit of 2^30",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", "t.obj"),

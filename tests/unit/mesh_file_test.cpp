@@ -62,6 +62,19 @@ TEST_F(MeshFile, ObjPolygonsBecomeTriangles) {
   EXPECT_EQ(model.spring_count(), 17 + 6 + (17 + 6 - 10));  // 17 grid edges + 6 diagonals, bending on interior edges
 }
 
+// The `v` lines assimp's OBJ reader keeps pass the check for those it skips (read_guards.hpp):
+// w and vertex colours, tabs, signs before a point, a comment, a line continued.
+TEST_F(MeshFile, ObjVertexLinesAssimpKeepsAreRead) {
+  Mesh m = load(write("k.obj", "v 0 0 0 1\nv\t1\t0\t0\nv 0 1 0 0.5 0.5 0.5\nv -.5 +.5 0 # a note\nv 1 \\\n1 0\n"
+                               "f 1 2 3\nf 2 5 3\nf 1 3 4\n"));
+  std::vector<std::array<float, 3>> got;
+  for (const Vec3f& p : m.position) got.push_back({p.x, p.y, p.z});
+  std::sort(got.begin(), got.end());
+  const std::vector<std::array<float, 3>> want = {{-0.5f, 0.5f, 0.f}, {0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}};
+  EXPECT_EQ(got, want);
+  EXPECT_EQ(m.triangle.size(), 3u);
+}
+
 TEST_F(MeshFile, ObjectsSharingPositionsAreWeldedAndCounted) {
   Mesh m = load(write("two.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n"
                                  "o b\nv 1 0 0\nv 0 0 1\nv 1 0 1\nf 4 6 5\n"));

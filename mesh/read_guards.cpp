@@ -1,0 +1,98 @@
+#include "read_guards.hpp"
+
+#include <assimp/Importer.hpp>
+
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace deformlab {
+
+namespace {
+
+[[noreturn]] void bad_line(const std::string& file, std::int64_t line, const std::string& what) {
+  throw std::invalid_argument("mesh file '" + file + "': line " + std::to_string(line) + ": " + what);
+}
+
+bool blank(char c) { return c == ' ' || c == '\t'; }
+
+// Whether assimp's OBJ reader counts the word at `at` as a number: one that starts with a
+// digit, '+' or '-', or with "nan" or "inf" in any case.
+bool counted_as_number(const std::string& line, std::size_t at) {
+  const auto c = static_cast<unsigned char>(line[at]);
+  if (std::isdigit(c) || c == '+' || c == '-') return true;
+  std::string head = line.substr(at, 3);
+  for (char& h : head) h = char(std::tolower(static_cast<unsigned char>(h)));
+  return head == "nan" || head == "inf";
+}
+
+// One logical OBJ line (continuations joined), first at physical line `number`.
+void check_obj_line(const std::string& path, const std::string& line, std::int64_t number) {
+  std::size_t at = 0;
+  while (at < line.size() && blank(line[at])) ++at;
+  const bool vertex = line.compare(at, 1, "v") == 0 && at + 1 < line.size() && blank(line[at + 1]);
+  const bool face = line.compare(at, 1, "f") == 0 && at + 1 < line.size() && blank(line[at + 1]);
+  if (!vertex && !face) return;
+  if (at > 0)
+    bad_line(path, number, std::string("an indented `") + line[at] + "` line, which assimp's OBJ reader skips");
+  if (!vertex) return;
+  int numbers = 0;
+  for (std::size_t k = 1; k < line.size(); ++k)
+    if (blank(line[k - 1]) && !blank(line[k]))
+      numbers += counted_as_number(line, k);
+  if (numbers != 3 && numbers != 4 && numbers != 6)
+    bad_line(path, number, "a vertex of " + std::to_string(numbers) + " numbers, which assimp's OBJ reader skips (it "
+             "keeps 3, 4 or 6, counting the words that start with a digit, + or -: write .5 as 0.5)");
+}
+
+}  // namespace
+
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// assimp's PLY reader loops for ever on a header cut off before its end_header line (the header
+// is text, within its first 64 KiB in any file we know; a file that only holds "ply" further on
+// fails assimp's PLY reader at once).
+void require_ply_header_end(const std::string& path, const Assimp::Importer& importer) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(in.gcount()));
+  const std::string ext = extension_of(path);
+  const bool magic = head.starts_with("ply") || head.starts_with("PLY");
+  const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
+  if (ply && head.find("end_header") == std::string::npos)
+    throw std::invalid_argument("mesh file '" + path +
+                                "': its PLY header has no end_header line in its first 64 KiB (a truncated or "
+                                "damaged file)");
+}
+
+// A skipped `v` line gives the vertices after it the numbers before, so that faces join other
+// vertices; a skipped `f` line drops a face.
+void require_obj_lines_read(const std::string& path) {
+  if (extension_of(path) != ".obj") return;
+  std::ifstream in(path, std::ios::binary);
+  std::string physical, logical;
+  std::int64_t number = 0, first = 0;
+  while (std::getline(in, physical)) {
+    ++number;
+    if (!physical.empty() && physical.back() == '\r') physical.pop_back();
+    if (logical.empty()) first = number;
+    if (!physical.empty() && physical.back() == '\\') {  // continued on the next line
+      physical.back() = ' ';
+      logical += physical;
+      continue;
+    }
+    logical += physical;
+    check_obj_line(path, logical, first);
+    logical.clear();
+  }
+  if (!logical.empty()) check_obj_line(path, logical, first);
+}
+
+}  // namespace deformlab
