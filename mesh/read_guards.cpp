@@ -30,13 +30,15 @@ bool counted_as_number(const std::string& line, std::size_t at) {
 
 // One logical OBJ line (continuations joined), first at physical line `number`.
 void check_obj_line(const std::string& path, const std::string& line, std::int64_t number) {
-  std::size_t at = 0;
+  const bool bom = number == 1 && line.starts_with("\xEF\xBB\xBF");  // UTF-8's byte-order mark
+  std::size_t at = bom ? 3 : 0;
   while (at < line.size() && blank(line[at])) ++at;
   const bool vertex = line.compare(at, 1, "v") == 0 && at + 1 < line.size() && blank(line[at + 1]);
   const bool face = line.compare(at, 1, "f") == 0 && at + 1 < line.size() && blank(line[at + 1]);
   if (!vertex && !face) return;
   if (at > 0)
-    bad_line(path, number, std::string("an indented `") + line[at] + "` line, which assimp's OBJ reader skips");
+    bad_line(path, number, std::string(bom ? "a byte-order mark before a `" : "an indented `") + line[at] +
+                               "` line, which assimp's OBJ reader skips");
   if (!vertex) return;
   int numbers = 0;
   for (std::size_t k = 1; k < line.size(); ++k)

@@ -19,7 +19,8 @@ void require_ply_header_end(const std::string& path, const Assimp::Importer& imp
 
 // An `.obj` line that assimp's OBJ reader skips: a `v` line whose words that it counts as
 // numbers (those starting with a digit, '+', '-', "nan" or "inf") are not 3, 4 or 6 (".5", a
-// missing coordinate), or a `v` or `f` line that starts with a space or a tab.
+// missing coordinate), or a `v` or `f` line that starts with a space, a tab or (the first line)
+// UTF-8's byte-order mark.
 void require_obj_lines_read(const std::string& path);
 
 }  // namespace deformlab
