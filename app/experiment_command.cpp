@@ -57,7 +57,7 @@ int experiment_command(const ExperimentArgs& a) {
   return report_errors([&] {
     if (!a.report_only) {  // builds the models: out of memory is bad input
       require_model_files(x, *sweep);
-      require_size_scenes(x, *sweep, a.file);
+      require_size_scenes(x, *sweep);
     }
     if (a.report_only && !calibration.is_null()) {
       // Records the calibration given in the folder's manifest; the cells stay as they are.

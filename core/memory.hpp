@@ -4,9 +4,16 @@
 #pragma once
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace deformlab {
+
+// A model or a run larger than this machine's memory: bad input to a run, a cell that does not
+// fit to a sweep.
+struct DoesNotFit : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 
 // The nodes and springs of a model, counted without building it.
 struct ModelSize {

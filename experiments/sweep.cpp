@@ -229,16 +229,20 @@ void size_model(ModelSpec& ms, int n) {
   ms.nz = ms.topology == Topology::lattice ? n : 1;
 }
 
-void require_size_scenes(const Experiment& x, const Sweep& s, const std::string& where) {
-  for (std::size_t k = 0; k < s.sizes.size(); ++k) {
+std::string size_key(const Sweep& s, int size) {
+  const auto k = std::find(s.sizes.begin(), s.sizes.end(), size) - s.sizes.begin();
+  return s.where + ".sweep.sizes[" + std::to_string(k) + "]: size " + size_label(size, s.lattice);
+}
+
+void require_size_scenes(const Experiment& x, const Sweep& s) {
+  for (const int n : s.sizes) {
     Scene scene = x.scene;
-    size_model(scene.model, s.sizes[k]);
+    size_model(scene.model, n);
     if (model_size(scene.model).nodes > kCheckedNodes) continue;
     try {
       resolve_params(scene, build_model(scene));
     } catch (const std::invalid_argument& e) {
-      bad_value(where + ".sweep.sizes[" + std::to_string(k) + "]",
-                "size " + size_label(s.sizes[k], s.lattice) + ": " + e.what());
+      throw std::invalid_argument(size_key(s, n) + ": " + e.what());
     }
   }
 }

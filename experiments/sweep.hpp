@@ -67,7 +67,9 @@ std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::st
 // input (a pin or drag node outside or on each other, a node deep in a collider: resolve_params),
 // checked before the first cell on every size of up to kCheckedNodes nodes (built for it).
 constexpr std::int64_t kCheckedNodes = std::int64_t(1) << 22;
-void require_size_scenes(const Experiment& x, const Sweep& s, const std::string& where);
+void require_size_scenes(const Experiment& x, const Sweep& s);
+// The key path of a grid size, for errors: "x.json.sweep.sizes[k]: size 64²".
+std::string size_key(const Sweep& s, int size);
 std::vector<Cell> cells(const Sweep& s);
 
 struct SweepProgress {

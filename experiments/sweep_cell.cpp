@@ -226,14 +226,21 @@ json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& ca
     if (auto why = size_grid(scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);
   const Model* m = nullptr;
   Params p;
-  try {  // std::invalid_argument goes on: the scene is bad input, whatever the pipeline
+  try {
     const int built = cache.models_built();
     const auto t0 = clock::now();
     m = &cache.model(scene, c);
     r["model_build_s"] = cache.models_built() == built ? 0.0 : std::chrono::duration<double>(clock::now() - t0).count();
     p = resolve_params(scene, *m);
+  } catch (const DoesNotFit& ex) {
+    return not_applicable(r, std::string("does not fit: ") + ex.what());
+  } catch (const std::invalid_argument& ex) {  // the scene is bad input on this model: the sweep stops
+    const std::string key = c.model.empty() ? size_key(s, c.size) : model_key(s, c.model), what = ex.what();
+    throw std::invalid_argument(what.starts_with(key) ? what : key + ": " + what);
   } catch (const std::bad_alloc&) {
     return not_applicable(r, "does not fit: out of host memory");
+  } catch (const std::exception& ex) {
+    return not_applicable(r, std::string("failed: ") + ex.what());
   }
   if (!c.model.empty())
     if (auto why = record_mesh(*m, scene, c, e, integ, r); !why.empty()) return not_applicable(r, why);

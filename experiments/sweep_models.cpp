@@ -24,10 +24,14 @@ Scene model_scene(const Experiment& x, const Sweep& s, const json& m, const std:
   return scene;
 }
 
-// The key path of the sweep's model k, for errors.
+}  // namespace
+
 std::string model_key(const Sweep& s, std::size_t k) { return s.where + ".sweep.models[" + std::to_string(k) + "]"; }
 
-}  // namespace
+std::string model_key(const Sweep& s, const std::string& name) {
+  const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == name; });
+  return model_key(s, std::size_t(m - s.models.begin()));
+}
 
 std::vector<SweepModel> parse_sweep_models(const json& j, const std::string& where) {
   if (!j.is_array() || j.empty()) bad_value(where, "expected a non-empty list of {\"name\": ..., \"model\": {...}}");
@@ -97,7 +101,7 @@ void require_model_files(const Experiment& x, const Sweep& s) {
 
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {
   const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == c.model; });
-  Scene scene = model_scene(x, s, m->model, model_key(s, std::size_t(m - s.models.begin())));
+  Scene scene = model_scene(x, s, m->model, model_key(s, c.model));
   if (!c.order.empty()) scene.model.mesh.order = *parse_node_order(c.order);
   return scene;
 }

@@ -23,6 +23,11 @@ void check_models_under_orders(const Sweep& s, const std::string& where);
 // before the first cell runs. A model generated or filled is checked at its first cell.
 void require_model_files(const Experiment& x, const Sweep& s);
 
+// The key path of the sweep's model k, or of the model named so, for errors:
+// "x.json.sweep.models[k]".
+std::string model_key(const Sweep& s, std::size_t k);
+std::string model_key(const Sweep& s, const std::string& name);
+
 // The experiment's scene with a model cell's model (relative files from the experiment's
 // folder) and order.
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c);

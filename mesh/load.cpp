@@ -4,6 +4,9 @@
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/LogStream.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/commonMetaData.h>
+#include <assimp/importerdesc.h>
+#include <assimp/metadata.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/version.h>
@@ -179,7 +182,6 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   DataLost lost;
   Assimp::Importer importer;
   require_ply_header_end(path, importer);
-  require_obj_lines_read(path);
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
   // Positions only: the other components are dropped before the other steps.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
@@ -193,6 +195,14 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   // Read first and checked for coordinates that are not finite, those of vertices no face uses
   // too, then processed.
   const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+  // Read by the OBJ reader, as it says, or (refused) named as OBJ: checked for the lines the
+  // reader skipped, which may be why it refused the file.
+  aiString format;
+  const aiImporterDesc* obj_reader = importer.GetImporterInfo(importer.GetImporterIndex(".obj"));
+  const bool obj = scene ? scene->mMetaData && scene->mMetaData->Get(AI_METADATA_SOURCE_FORMAT, format) &&
+                               obj_reader && std::string(format.C_Str()) == obj_reader->mName
+                         : extension_of(path) == ".obj";
+  if (obj) require_obj_lines_read(path);
   if (!scene) refused_by_assimp(path, importer);
   if (!lost.first.empty()) {
     while (!lost.first.empty() && std::isspace(static_cast<unsigned char>(lost.first.back()))) lost.first.pop_back();

@@ -33,8 +33,10 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
   const bool bom = number == 1 && line.starts_with("\xEF\xBB\xBF");  // UTF-8's byte-order mark
   std::size_t at = bom ? 3 : 0;
   while (at < line.size() && blank(line[at])) ++at;
-  const bool vertex = line.compare(at, 1, "v") == 0 && at + 1 < line.size() && blank(line[at + 1]);
-  const bool face = line.compare(at, 1, "f") == 0 && at + 1 < line.size() && blank(line[at + 1]);
+  // A keyword ends at a blank or the line's end ("v" alone is a vertex of no numbers).
+  auto keyword = [&](char k) { return line[at] == k && (at + 1 == line.size() || blank(line[at + 1])); };
+  if (at == line.size()) return;
+  const bool vertex = keyword('v'), face = keyword('f');
   if (!vertex && !face) return;
   if (at > 0)
     bad_line(path, number, std::string(bom ? "a byte-order mark before a `" : "an indented `") + line[at] +
@@ -75,26 +77,37 @@ void require_ply_header_end(const std::string& path, const Assimp::Importer& imp
 }
 
 // A skipped `v` line gives the vertices after it the numbers before, so that faces join other
-// vertices; a skipped `f` line drops a face.
+// vertices; a skipped `f` line drops a face. Lines end at "\n", "\r\n" or "\r", and one ending
+// with a backslash goes on with the next, both joined with nothing between, as assimp reads them.
 void require_obj_lines_read(const std::string& path) {
-  if (extension_of(path) != ".obj") return;
   std::ifstream in(path, std::ios::binary);
-  std::string physical, logical;
-  std::int64_t number = 0, first = 0;
-  while (std::getline(in, physical)) {
+  std::string logical, chunk(1 << 20, '\0');
+  std::int64_t number = 0, first = 1;
+  bool after_cr = false;  // "\r\n" ends one line
+  auto end_line = [&](bool at_end) {
     ++number;
-    if (!physical.empty() && physical.back() == '\r') physical.pop_back();
-    if (logical.empty()) first = number;
-    if (!physical.empty() && physical.back() == '\\') {  // continued on the next line
-      physical.back() = ' ';
-      logical += physical;
-      continue;
-    }
-    logical += physical;
+    const bool continued = !logical.empty() && logical.back() == '\\';
+    if (continued) logical.pop_back();
+    if (continued && !at_end) return;
     check_obj_line(path, logical, first);
     logical.clear();
+    first = number + 1;
+  };
+  while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0) {
+    for (std::streamsize k = 0; k < in.gcount(); ++k) {
+      const char c = chunk[std::size_t(k)];
+      if (c == '\n' && after_cr) {
+        after_cr = false;
+        continue;
+      }
+      after_cr = c == '\r';
+      if (c == '\n' || c == '\r')
+        end_line(false);
+      else
+        logical += c;
+    }
   }
-  if (!logical.empty()) check_obj_line(path, logical, first);
+  if (!logical.empty()) end_line(true);
 }
 
 }  // namespace deformlab

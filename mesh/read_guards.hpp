@@ -17,10 +17,10 @@ std::string extension_of(const std::string& path);
 // magic word at its start) whose header has no end_header line in its first 64 KiB.
 void require_ply_header_end(const std::string& path, const Assimp::Importer& importer);
 
-// An `.obj` line that assimp's OBJ reader skips: a `v` line whose words that it counts as
-// numbers (those starting with a digit, '+', '-', "nan" or "inf") are not 3, 4 or 6 (".5", a
-// missing coordinate), or a `v` or `f` line that starts with a space, a tab or (the first line)
-// UTF-8's byte-order mark.
+// A line of an OBJ file (read by assimp's OBJ reader) that the reader skips: a `v` line whose
+// words that it counts as numbers (those starting with a digit, '+', '-', "nan" or "inf") are not
+// 3, 4 or 6 (".5", a missing coordinate), or a `v` or `f` line that starts with a space, a tab or
+// (the first line) UTF-8's byte-order mark.
 void require_obj_lines_read(const std::string& path);
 
 }  // namespace deformlab

@@ -43,8 +43,8 @@ void check_memory(std::int64_t nodes, std::int64_t springs, std::int64_t element
   if (!limit) return;
   const std::int64_t need = model_host_bytes({nodes, springs, false}) + elements * 64;  // sorting the elements' sides
   if (need > limit->bytes)
-    throw std::invalid_argument("its model needs up to " + gib(need) + " of host memory; " +
-                                limit->name + " leaves " + gib(limit->bytes));
+    throw DoesNotFit("its model needs up to " + gib(need) + " of host memory; " + limit->name + " leaves " +
+                     gib(limit->bytes));
 }
 void check_memory(const Mesh& mesh) {
   check_memory(std::int64_t(mesh.position.size()), mesh_spring_bound(mesh),
@@ -62,6 +62,12 @@ Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>
   return load_mesh(ms.file, notes);
 }
 
+// `e` again, of its kind (DoesNotFit or not), with `what` before its message.
+[[noreturn]] void rethrow_naming(const std::string& what, const std::invalid_argument& e) {
+  if (dynamic_cast<const DoesNotFit*>(&e)) throw DoesNotFit(what + ": " + e.what());
+  throw std::invalid_argument(what + ": " + e.what());
+}
+
 // f(), with `what` before the message of its std::invalid_argument (a WriteError names its own
 // file).
 template <class F>
@@ -71,7 +77,7 @@ auto naming(const std::string& what, F&& f) {
   } catch (const WriteError&) {
     throw;
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(what + ": " + e.what());
+    rethrow_naming(what, e);
   }
 }
 
@@ -110,7 +116,7 @@ void check_fill_size(const Mesh& surface, float cell_size) {
   try {
     check_memory(std::int64_t(n), std::int64_t(n * 16), std::int64_t(n * 6.6));
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(about.str() + ": " + e.what());
+    rethrow_naming(about.str(), e);
   }
 }
 
@@ -172,8 +178,7 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
   try {
     check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("generated " + std::string(to_string(shape.kind)) + " of " + about_nodes(n) + ": " +
-                                e.what());
+    rethrow_naming("generated " + std::string(to_string(shape.kind)) + " of " + about_nodes(n), e);
   }
   return generate_shape(shape, save_to);
 }

@@ -320,6 +320,11 @@ const std::vector<BadInput>& cases() {
            "m.obj': line 2: a vertex of 2 numbers, which assimp's OBJ reader skips (it keeps 3, 4 or 6, counting the "
            "words that start with a digit, + or -: write .5 as 0.5)",
            "v 0 0 0\nv .5 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),
+      mesh("mesh_obj_vertex_continued", "{\"file\": \"m.obj\"}",
+           "m.obj': line 2: a vertex of 2 numbers",  // "v 1\\" and "0 0" join as "v 10 0"
+           "v 0 0 0\nv 1\\\n0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),
+      mesh("mesh_obj_by_content", "{\"file\": \"m.txt\"}", "m.txt': line 2: a vertex of 2 numbers",
+           "v 0 0 0\nv .5 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n", "m.txt"),
       mesh("mesh_obj_face_indented", "{\"file\": \"m.obj\"}",
            "m.obj': line 6: an indented `f` line, which assimp's OBJ reader skips",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n\t f 2 4 3\n"),

@@ -116,7 +116,8 @@ TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
 // stops the experiment at its first cell with one line and exit 2, keeping the cells before.
 TEST_F(Cli, AFilledModelWhosePinsPickNothingStopsTheExperiment) {
   write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
-  write("x.json", R"({"name": "filled", "scene": {"model": {"type": "mesh", "file": "t.obj", "pins": "none"}, "drag": null},
+  write("x.json", R"({"name": "filled",
+      "scene": {"model": {"type": "mesh", "file": "t.obj", "pins": "none"}, "drag": null},
       "sweep": {"models": [{"name": "a", "model": {"pins": "none"}},
                            {"name": "b", "model": {"fill": "tetrahedra", "cell_size": 0.3,
                                                    "pins": [{"box": [[5, 5, 5], [6, 6, 6]]}]}}],
@@ -127,6 +128,25 @@ TEST_F(Cli, AFilledModelWhosePinsPickNothingStopsTheExperiment) {
                        ".sweep.models[1].model.pins[0]: the box holds no node of the model\n");
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__a.json"))["status"], "ok");
   EXPECT_FALSE(fs::exists(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__b.json"));
+}
+
+// A model too large for this machine is a cell that does not fit, as a grid size is, and the
+// sweep goes on.
+TEST_F(Cli, AGeneratedModelOverTheHostsMemoryIsACellThatDoesNotFit) {
+  write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write("x.json", R"({"name": "big",
+      "scene": {"model": {"type": "mesh", "file": "t.obj", "pins": "none"}, "drag": null},
+      "sweep": {"models": [{"name": "box",
+                            "model": {"generate": {"shape": "box", "size": [1, 1, 1], "cell_size": 0.00085}}},
+                           {"name": "a", "model": {"pins": "none"}}],
+                "pipelines": ["cpu"], "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})");
+  const Result r = run("experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  const nlohmann::json box = nlohmann::json::parse(slurp(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__box.json"));
+  EXPECT_EQ(box["status"], "n/a");
+  const std::string why = box["reason"];
+  EXPECT_EQ(why.rfind("does not fit: generated box of about 9.85e+08 nodes: its model needs", 0), 0u) << why;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__a.json"))["status"], "ok");
 }
 
 // An experiment draws frames of its own scene after its cells: a grid of 2^30 nodes (40 GiB on a

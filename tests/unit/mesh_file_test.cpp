@@ -63,7 +63,7 @@ TEST_F(MeshFile, ObjPolygonsBecomeTriangles) {
 }
 
 // The `v` lines assimp's OBJ reader keeps pass the check for those it skips (read_guards.hpp):
-// w and vertex colours, tabs, signs before a point, a comment, a line continued.
+// w and vertex colours, tabs, signs before a point, a comment, a line continued, CR line ends.
 TEST_F(MeshFile, ObjVertexLinesAssimpKeepsAreRead) {
   Mesh m = load(write("k.obj", "v 0 0 0 1\nv\t1\t0\t0\nv 0 1 0 0.5 0.5 0.5\nv -.5 +.5 0 # a note\nv 1 \\\n1 0\n"
                                "f 1 2 3\nf 2 5 3\nf 1 3 4\n"));
@@ -73,6 +73,8 @@ TEST_F(MeshFile, ObjVertexLinesAssimpKeepsAreRead) {
   const std::vector<std::array<float, 3>> want = {{-0.5f, 0.5f, 0.f}, {0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}};
   EXPECT_EQ(got, want);
   EXPECT_EQ(m.triangle.size(), 3u);
+  // Lines that end in a carriage return alone.
+  EXPECT_EQ(load(write("cr.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r")).position.size(), 3u);
 }
 
 TEST_F(MeshFile, ObjectsSharingPositionsAreWeldedAndCounted) {

@@ -370,7 +370,7 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
     EXPECT_EQ(swept.count(n), std::size_t(x.raw.contains("sweep"))) << n;
     EXPECT_NO_THROW(parse_sweep(x.raw, n)) << n << ": its sweep reads";
     if (const auto s = parse_sweep(x.raw, n)) {
-      EXPECT_NO_THROW(require_size_scenes(x, *s, n)) << n << ": its scene holds at each size";
+      EXPECT_NO_THROW(require_size_scenes(x, *s)) << n << ": its scene holds at each size";
     }
   }
   EXPECT_EQ(swept.count("paper-drag"), 0u);
