@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "core/interrupt.hpp"
 #include "run_input.hpp"
 #include "core/number_text.hpp"
 #include "core/one_line.hpp"
@@ -100,6 +101,7 @@ int experiment_command(const ExperimentArgs& a) {
         std::cout << "]" << std::endl;
       };
       nlohmann::json command = a.argv;
+      const InterruptCatcher signals;  // between cells: the cells done stay
       const int ran = run_sweep(x, *sweep, dir, o, command);
       std::cout << "ran " << ran << " cells, kept " << int(cells(*sweep).size()) - ran << "\n";
     }

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "core/interrupt.hpp"
 #include "core/one_line.hpp"
 #include "command_line.hpp"
 #include "experiments/experiment.hpp"
@@ -15,6 +16,9 @@ int report_errors(const std::function<int()>& body) {
   } catch (const std::invalid_argument& e) {
     std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
     return 2;
+  } catch (const Interrupted& e) {
+    std::cerr << "deformlab: error: " << one_line(e.what()) << "\n";
+    return 128 + e.signal;
   } catch (const std::bad_alloc&) {  // a size the checks before allocating did not refuse
     std::cerr << "deformlab: error: out of memory (host or device): the model or its outputs do not fit this machine\n";
     return 2;

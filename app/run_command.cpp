@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "core/clock_watch.hpp"
 #include "core/cpu_backend.hpp"
+#include "core/interrupt.hpp"
 #include "core/number_text.hpp"
 #include "core/run.hpp"
 #include "experiments/output.hpp"
@@ -108,7 +109,11 @@ Ran run_pipeline(const RunArgs& a, const RunInput& in, Pipeline& pipe, Profiler&
 json compare_with_reference(const RunInput& in, const State& final_state, int steps) {
   auto ref = make_cpu_pipeline({in.model, in.params, in.integ}, Precision::f64, true);
   ref->set_state(rest_state(in.model));
-  for (int s = 0; s < steps; ++s) ref->step();
+  for (int s = 0; s < steps; ++s) {
+    ref->step();
+    if (const int sig = InterruptCatcher::caught())
+      throw Interrupted(sig, signal_name(sig) + " in --compare's reference run: the run stopped and wrote nothing");
+  }
   return {{"reference", "double-precision CPU (OpenMP)"},
           {"steps", steps},
           {"max_position_error_relative_to_extent", relative_position_error(final_state, ref->state())}};
@@ -294,7 +299,9 @@ int run_command(const RunArgs& a) {
   return report_errors([&] {
     // 1. Everything is read and checked before anything is written (bad input: exit 2).
     const RunInput in = read_run_input(a);
-    // 2. Run, writing into a staging folder that is committed only on success.
+    // 2. Run, writing into a staging folder that is committed only on success (a signal stops
+    // the run and leaves the folder as it was).
+    const InterruptCatcher signals;
     std::vector<std::string> writes = {"timings.csv", "spans.csv"};
     if (!a.no_state) writes.push_back("state.ply");
     if (a.trace) writes.push_back("trace.json");
@@ -332,7 +339,13 @@ int run_command(const RunArgs& a) {
     // window of steps in kRunSampling (the step clock's median then comes from steps without
     // them, as in an experiment cell or the bench); a trace times every step.
     profiler.sample_every(a.trace ? 1 : kRunSampling);
-    const Ran ran = run_pipeline(a, in, *pipe, profiler, dir);
+    const Ran ran = [&] {
+      try {
+        return run_pipeline(a, in, *pipe, profiler, dir);
+      } catch (const Interrupted& e) {
+        throw Interrupted(e.signal, std::string(e.what()) + ": the run stopped and wrote nothing");
+      }
+    }();
     profiler.end_stream();
     const RunResult& r = ran.result;
     const State final_state = pipe->state();

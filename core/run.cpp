@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "interrupt.hpp"
 #include "number_text.hpp"
 #include "springs.hpp"
 
@@ -214,6 +215,8 @@ RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions&
     times.after_step();
     if (opt.after_step) opt.after_step(step);
     if (opt.progress) opt.progress(step, r.last_displacement);
+    if (const int sig = InterruptCatcher::caught())
+      throw Interrupted(sig, signal_name(sig) + " at step " + std::to_string(step) + " of " + std::to_string(p.max_steps));
     if (stop) {
       r.converged = true;
       break;

@@ -86,7 +86,8 @@ struct RunOptions {
   Integrator integrator = Integrator::semi_implicit_euler;  // the pipeline's, for the divergence message
 };
 
-// Throws DivergenceError naming the step, what was seen and the stability limit.
+// Throws DivergenceError naming the step, what was seen and the stability limit, and
+// Interrupted after the step where an InterruptCatcher caught a signal.
 RunResult run(Pipeline& pipe, const Model& m, const Params& p, const RunOptions& opt);
 
 }  // namespace deformlab

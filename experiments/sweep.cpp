@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/clock_watch.hpp"
+#include "core/interrupt.hpp"
 #include "core/json_file.hpp"
 #include "core/run.hpp"
 #include "core/scene.hpp"
@@ -421,6 +422,7 @@ void require_frames_fit(const Experiment& x, const Sweep& s, const fs::path& dir
 int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const SweepOptions& o, const json& command) {
   using clock = std::chrono::steady_clock;
   require_same_experiment(dir, x.name);
+  const bool created = !fs::exists(dir);
   fs::create_directories(dir / "cells");
   reclaim_temporaries(dir);
   reclaim_temporaries(dir / "cells");
@@ -460,7 +462,12 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     if (prog.kept) {
       ++prog.skipped;
     } else {
-      r = run_cell(x, s, c, cache);
+      try {
+        r = run_cell(x, s, c, cache);
+      } catch (const std::invalid_argument&) {  // bad input found at the cell: the sweep stops
+        if (created && ran == 0) fs::remove_all(dir);  // nothing measured: the folder this run made goes
+        throw;
+      }
       r["measurement"] = cell_measurement(method, s, c.model);
       write_atomically(file, r.dump(2) + "\n");
       ++ran;
@@ -468,6 +475,10 @@ int run_sweep(const Experiment& x, const Sweep& s, const fs::path& dir, const Sw
     ++prog.done;
     prog.elapsed_s = std::chrono::duration<double>(clock::now() - start).count();
     if (o.on_cell) o.on_cell(c, r, prog);
+    if (const int sig = InterruptCatcher::caught())
+      throw Interrupted(sig, signal_name(sig) + " after " + std::to_string(prog.done) + " of " +
+                                 std::to_string(prog.total) + " cells: the cells done are kept, and the experiment "
+                                 "run again measures the rest");
   }
   cache = {};
   if (s.frames > 0 && !fs::exists(dir / "frames")) {

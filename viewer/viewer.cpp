@@ -6,11 +6,11 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "core/interrupt.hpp"
 #include "core/number_text.hpp"
 #include "core/one_line.hpp"
 #include "core/run.hpp"
@@ -35,14 +35,6 @@ using Clock = std::chrono::steady_clock;
 
 nlohmann::json to_json(Vec3f v) { return {v.x, v.y, v.z}; }
 
-// SIGINT or SIGTERM asks the loop to end as the window's close button does, so that the
-// recording, the script and the summary are still written.
-volatile std::sig_atomic_t g_signal = 0;
-void on_signal(int sig) {
-  g_signal = sig;
-  std::signal(sig, SIG_DFL);  // a second one ends the process at once
-}
-
 class Viewer {
  public:
   Viewer(Window& w, Session& s, const ViewOptions& o)
@@ -58,7 +50,9 @@ class Viewer {
   int loop() {
     int code = 0;
     const int video_frames = o_.seconds > 0 ? std::max(1, int(std::lround(o_.seconds * kVideoFps))) : 0;  // 0: no limit
-    while (!quit_ && !w_.should_close() && !g_signal) {
+    // SIGINT or SIGTERM ends the loop as the window's close button does, so that the
+    // recording, the script and the summary are still written.
+    while (!quit_ && !w_.should_close() && !InterruptCatcher::caught()) {
       std::vector<Event> events;
       for (; next_ < script_.size() && script_[next_].frame <= frame_; ++next_) events.push_back(script_[next_]);
       w_.poll(frame_, events);
@@ -72,8 +66,8 @@ class Viewer {
       ++frame_;
       if ((o_.frames > 0 && frame_ >= o_.frames) || (video_frames > 0 && frame_ >= video_frames)) quit_ = true;
     }
-    if (g_signal)
-      std::cerr << "deformlab: note: " << (g_signal == SIGINT ? "SIGINT" : "SIGTERM") << " at frame " << frame_
+    if (const int sig = InterruptCatcher::caught())
+      std::cerr << "deformlab: note: " << signal_name(sig) << " at frame " << frame_
                 << ": ending the session as its window's close does\n";
     try {
       if (rec_) finish_recording();
@@ -471,18 +465,7 @@ class Viewer {
 }  // namespace
 
 int run(Window& w, Session& s, const ViewOptions& o) {
-  struct Handlers {  // on_signal while the loop runs, but for a signal the process ignores (nohup)
-    Handlers() {
-      g_signal = 0;
-      for (int k = 0; k < 2; ++k)
-        if ((old[k] = std::signal(kSignals[k], on_signal)) == SIG_IGN) std::signal(kSignals[k], SIG_IGN);
-    }
-    ~Handlers() {
-      for (int k = 0; k < 2; ++k) std::signal(kSignals[k], old[k]);
-    }
-    const int kSignals[2] = {SIGINT, SIGTERM};
-    void (*old[2])(int) = {};
-  } handlers;
+  const InterruptCatcher signals;
   return Viewer(w, s, o).loop();
 }
 

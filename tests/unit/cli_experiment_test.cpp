@@ -113,7 +113,8 @@ TEST_F(Cli, AMeshSweepWithoutOrdersReportsItsCells) {
 }
 
 // A generated or filled model is built only for its cells: one whose pins pick no node of it
-// stops the experiment at its first cell with one line and exit 2, keeping the cells before.
+// stops the experiment at its first cell with one line and exit 2, keeping the cells before
+// (with none, the folder the experiment made is removed).
 TEST_F(Cli, AFilledModelWhosePinsPickNothingStopsTheExperiment) {
   write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
   write("x.json", R"({"name": "filled",
@@ -128,6 +129,14 @@ TEST_F(Cli, AFilledModelWhosePinsPickNothingStopsTheExperiment) {
                        ".sweep.models[1].model.pins[0]: the box holds no node of the model\n");
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__a.json"))["status"], "ok");
   EXPECT_FALSE(fs::exists(dir_ / "r" / "cells" / "cpu__semi-implicit-euler__b.json"));
+  // With no cell measured, the folder it made is gone.
+  nlohmann::json x = nlohmann::json::parse(slurp(dir_ / "x.json"));
+  x["sweep"]["models"].erase(0);
+  write("y.json", x.dump());
+  const Result first = run("experiment " + (dir_ / "y.json").string() + " --out " + (dir_ / "s").string());
+  EXPECT_EQ(first.code, 2);
+  EXPECT_NE(first.err.find("y.json.sweep.models[0].model.pins[0]: the box holds no node"), std::string::npos) << first.err;
+  EXPECT_FALSE(fs::exists(dir_ / "s"));
 }
 
 // A model too large for this machine is a cell that does not fit, as a grid size is, and the

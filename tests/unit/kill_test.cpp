@@ -1,6 +1,7 @@
-// Killed runs and sweeps (SIGKILL to a real child process at several moments): a killed run
-// leaves its output folder as it was, a killed sweep completes when run again with every cell
-// valid, and no temporary of a killed process outlives the next run.
+// Killed and interrupted runs and sweeps (SIGKILL, SIGINT, SIGTERM to a real child process):
+// a killed run leaves its output folder as it was, an interrupted one says so as well, a killed
+// or interrupted sweep completes when run again with every cell valid, and no temporary of a
+// killed process outlives the next run.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,24 +16,30 @@
 namespace deformlab::test {
 namespace {
 
-// Starts `deformlab ARGS` and kills it with SIGKILL after `ms` milliseconds (or lets it
-// end first); returns whether the kill came before the end.
-bool kill_after(const std::string& args, int ms) {
+// Starts `deformlab ARGS` (its stderr into `err`, if given) and sends it `sig` after `ms`
+// milliseconds (or lets it end first); returns whether the signal came before the end, and
+// the wait status in `status`.
+bool signal_after(const std::string& args, int ms, int sig, int& status, const fs::path& err = "/dev/null") {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const std::string cmd = std::string("exec ") + DEFORMLAB_EXE + " " + args + " >/dev/null 2>&1 </dev/null";
+    const std::string cmd =
+        std::string("exec ") + DEFORMLAB_EXE + " " + args + " >/dev/null 2>" + err.string() + " </dev/null";
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-  int status = 0;
   while (std::chrono::steady_clock::now() < end) {
     if (::waitpid(pid, &status, WNOHANG) == pid) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ::kill(pid, SIGKILL);
+  ::kill(pid, sig);
   ::waitpid(pid, &status, 0);
   return true;
+}
+
+bool kill_after(const std::string& args, int ms) {
+  int status = 0;
+  return signal_after(args, ms, SIGKILL, status);
 }
 
 // Every regular file under `dir` by relative path, with its contents.
@@ -70,6 +77,51 @@ TEST_F(Cli, KilledRunLeavesTheFolderAsItWas) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(temporaries(out), std::vector<std::string>{}) << "the killed runs' staging folders are reclaimed";
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "manifest.json"))["result"]["steps"], 12);
+}
+
+// SIGINT or SIGTERM stops a run after its step with one line and exit 128 + the signal: a
+// folder the run made is gone, an earlier run's is as it was.
+TEST_F(Cli, InterruptedRunSaysSoAndLeavesTheFolderAsItWas) {
+  const fs::path out = dir_ / "run", fresh = dir_ / "fresh", err = dir_ / "err.txt";
+  ASSERT_EQ(run("run --pipeline cpu --grid 8x6 --steps 10 --out " + out.string()).code, 0);
+  const auto before = files_of(out);
+  for (const int sig : {SIGINT, SIGTERM})
+    for (const fs::path& to : {out, fresh}) {
+      int status = 0;
+      ASSERT_TRUE(signal_after("run --pipeline cpu --grid 256x256 --steps 1000000 --out " + to.string(), 1500, sig,
+                               status, err));
+      ASSERT_TRUE(WIFEXITED(status)) << "ended by the signal itself";
+      EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+      const std::string text = slurp(err), name = sig == SIGINT ? "SIGINT" : "SIGTERM";
+      EXPECT_EQ(text.rfind("deformlab: error: " + name + " at step ", 0), 0u) << text;
+      EXPECT_NE(text.find(" of 1000000: the run stopped and wrote nothing\n"), std::string::npos) << text;
+      EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
+    }
+  EXPECT_EQ(files_of(out), before);
+  EXPECT_FALSE(fs::exists(fresh));
+}
+
+// A sweep stops between cells: those done are kept, and running it again measures the rest.
+TEST_F(Cli, InterruptedSweepKeepsItsCells) {
+  const fs::path file = write("stop.json", R"({"name": "stop", "base": "paper-drag", "integrator": "semi-implicit-euler",
+    "sweep": {"sizes": [160, 192, 224, 256, 288, 320], "pipelines": ["cpu", "omp"],
+              "warmup": 2, "steps": 4, "repetitions": 3, "frames": 0}})");
+  const fs::path out = dir_ / "sweep", err = dir_ / "err.txt";
+  const std::string args = "experiment " + file.string() + " --out " + out.string();
+  int status = 0;
+  ASSERT_TRUE(signal_after(args, 1500, SIGINT, status, err)) << "the sweep should still be running";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const std::string text = slurp(err);
+  const std::size_t at = text.find("deformlab: error: SIGINT after ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const int done = std::stoi(text.substr(at + 31));
+  EXPECT_NE(text.find(" of 12 cells: the cells done are kept", at), std::string::npos) << text;
+  EXPECT_EQ(int(files_of(out / "cells").size()), done);
+  const Result r = run(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ran " + std::to_string(12 - done) + " cells, kept " + std::to_string(done)), std::string::npos)
+      << r.out;
 }
 
 TEST_F(Cli, KilledSweepCompletesWhenRunAgain) {
