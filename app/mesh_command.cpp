@@ -2,6 +2,7 @@
 // scene can name as its model's "file", so that runs share one mesh.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <stdexcept>
 
@@ -39,6 +40,23 @@ Scene chosen_scene(const MeshArgs& a) {
   throw std::invalid_argument("--model '" + *a.model + "': " + whose + " has no such model (its models: " + names + ")");
 }
 
+// A file already at `out` is replaced only where it is a Gmsh mesh and not the one the model
+// is filled from.
+void require_replaceable_mesh(const std::string& out, const MeshSpec& ms) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!ms.file.empty() && fs::equivalent(out, ms.file, ec))
+    throw std::invalid_argument("--out '" + out + "' is the mesh file the model is filled from (model.file): name "
+                                "another file");
+  std::ifstream in(out, std::ios::binary);
+  std::string head(12, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  if (!head.starts_with("$MeshFormat"))
+    throw std::invalid_argument("--out '" + out + "' holds a file that is not a Gmsh mesh (it does not start with "
+                                "$MeshFormat), which this would replace: remove it or name another file");
+}
+
 }  // namespace
 
 int mesh_command(const MeshArgs& a) {
@@ -58,6 +76,7 @@ int mesh_command(const MeshArgs& a) {
       throw std::invalid_argument("the scene's model (" + describe(scene.model) +
                                   ") is neither generated nor filled: only a model's \"generate\" or \"fill\" "
                                   "makes a mesh to write");
+    require_replaceable_mesh(a.out, ms);
     const auto t0 = std::chrono::steady_clock::now();
     const Mesh m = ms.generate ? generated_mesh(*ms.generate, a.out) : filled_mesh(ms, a.out);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -437,6 +437,14 @@ const std::vector<BadInput>& cases() {
        {{"s.json", R"({"model": {"type": "mesh", "file": "t.obj", "fill": "tetrahedra", "pins": "none"}})"},
         {"t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
         {"f.txt", "x"}}},
+      {"mesh_out_is_the_filled_file", "mesh --scene {dir}/s.json --out {dir}/t.msh",
+       "t.msh' is the mesh file the model is filled from (model.file)",
+       {{"s.json", R"({"model": {"type": "mesh", "file": "t.msh", "fill": "tetrahedra", "pins": "none"}})"},
+        {"t.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+                  "$Elements\n4\n1 2 2 0 1 1 3 2\n2 2 2 0 1 1 2 4\n3 2 2 0 1 1 4 3\n4 2 2 0 1 2 3 4\n$EndElements\n"}}},
+      {"mesh_out_not_a_mesh", "mesh --scene {dir}/s.json --out {dir}/mine.msh",
+       "mine.msh' holds a file that is not a Gmsh mesh",
+       {{"s.json", G(R"({"shape": "sheet", "size": [0.1, 0.1], "cell_size": 0.05})")}, {"mine.msh", "my notes\n"}}},
       // `deformlab calibrate --out`: checked before the measurement, which takes seconds
       {"calibrate_out_no_folder", "calibrate --out {dir}/none/c.json", "none/c.json': no folder '"},
       {"calibrate_out_a_folder", "calibrate --out {dir}", "' is a folder"},
