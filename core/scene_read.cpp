@@ -13,6 +13,7 @@
 
 #include "json_file.hpp"
 #include "memory.hpp"
+#include "physics.hpp"  // MAX_SPHERES
 
 namespace deformlab {
 
@@ -411,6 +412,9 @@ void apply_json(Scene& s, const json& j, const std::string& where, const std::st
   if (j.contains("spheres")) {
     const auto& a = j["spheres"];
     if (!a.is_array()) bad_value(where + ".spheres", "expected a list");
+    if (a.size() > MAX_SPHERES)
+      bad_value(where + ".spheres", "at most " + std::to_string(MAX_SPHERES) + " spheres are supported, the scene has " +
+                                        std::to_string(a.size()));
     p.spheres.clear();
     for (std::size_t k = 0; k < a.size(); ++k) {
       const std::string w = where + ".spheres[" + std::to_string(k) + "]";

@@ -47,7 +47,8 @@ Experiment from_json(const json& j, const std::string& where, const std::string&
       b = load_experiment_by_name(j["base"].get<std::string>(), dir);
     } catch (const std::invalid_argument& e) {  // named here only where no file of the chain names it
       const std::string what = e.what();
-      throw std::invalid_argument(what.starts_with("no experiment file or built-in") ? where + ".base: " + what : what);
+      const bool unnamed = what.starts_with("no experiment file or built-in") || what.starts_with("cannot open");
+      throw std::invalid_argument(unnamed ? where + ".base: " + what : what);
     }
     x.pipeline = b.pipeline;
     x.integrator = b.integrator;

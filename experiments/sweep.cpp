@@ -67,7 +67,7 @@ std::vector<std::string> strings(const json& j, const std::string& where) {
 
 int positive(const json& j, const std::string& where) {
   if (!j.is_number_integer() || j.get<std::int64_t>() < 1 || j.get<std::int64_t>() > 1'000'000)
-    bad_value(where, "expected a positive integer");
+    bad_value(where, "expected an integer from 1 to 1000000");
   return j.get<int>();
 }
 

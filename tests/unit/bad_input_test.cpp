@@ -451,6 +451,9 @@ const std::vector<BadInput>& cases() {
       scene("grid_mesh_key", "{\"model\": {\"file\": \"m.obj\"}}", "s.json.model.file: a key of mesh models"),
       scene("drag_node_box", "{\"drag\": {\"node\": {\"box\": [[0, 0, 0], [1, 1, 1]]}}}",
             "s.json.drag.node: expected a node index, \"center\" or {\"nearest\": [x, y, z]}"),
+      scene("spheres_too_many", "{\"spheres\": [" + repeated("{\"center\": [0, 9, 0], \"radius\": 0.1}, ", 8) +
+                                    "{\"center\": [0, 9, 0], \"radius\": 0.1}]}",
+            "s.json.spheres: at most 8 spheres are supported, the scene has 9"),
       scene("threshold_zero_in_file", "{\"threshold\": 0}", "s.json.threshold: expected a number > 0"),
       scene("min_steps_negative", "{\"min_steps\": -1}", "s.json.min_steps: expected an integer >= 0"),
       scene("max_steps_zero", "{\"max_steps\": 0}", "s.json.max_steps: expected an integer >= 1"),
@@ -460,6 +463,8 @@ const std::vector<BadInput>& cases() {
       scene("runaway_zero", "{\"runaway_factor\": 0}", "s.json.runaway_factor: expected a number > 0"),
       // experiment and calibration files
       {"experiment_key", "run --experiment {dir}/x.json", "x.json.pipline: unknown key", {{"x.json", "{\"pipline\": \"cpu\"}"}}},
+      {"experiment_base_missing", "run --experiment {dir}/x.json", "x.json.base: cannot open experiment file '",
+       {{"x.json", "{\"base\": \"none.json\"}"}}},
       {"experiment_given_a_scene", "run --experiment {dir}/x.json",
        "x.json.dt: unknown key (expected name, description, pipeline, integrator, until_converged, base, scene, sweep); "
        "a scene's key: put it under \"scene\" (a file that is a scene goes to --scene)",
