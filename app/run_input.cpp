@@ -343,9 +343,16 @@ RunInput read(const RunArgs& a, bool view) {
     throw BadInput("--compare reference: the pipeline run is 'reference' itself");
   // A grid is counted before it is built; a mesh once it is read.
   const bool mesh = in.x.scene.model.topology == Topology::general;
-  if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
   const auto t0 = std::chrono::steady_clock::now();
-  in.model = build_model(in.x.scene);
+  try {
+    if (!mesh) check_fits(in, bool(a.compare), model_size(in.x.scene.model));
+    in.model = build_model(in.x.scene);
+  } catch (const std::invalid_argument& e) {  // a grid too large: named by where its size was given
+    if (mesh) throw;
+    throw BadInput(std::string(a.grid ? "--grid" : a.lattice ? "--lattice" : a.scene ? *a.scene + ".model" :
+                               a.experiment ? *a.experiment + ".scene.model" : "the paper-drag experiment's model") +
+                   " (" + describe(in.x.scene.model) + "): " + e.what());
+  }
   if (mesh) check_fits(in, bool(a.compare), in.model.size());
   in.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   in.params = resolve_params(in.x.scene, in.model);

@@ -133,13 +133,13 @@ const std::vector<BadInput>& cases() {
            "64' has a name of 247 bytes, more than 200 (its file's name)",
        {{"x.json", R"({"base": "quick", "sweep": {"sizes": [8], "pipelines": ["glsl-compute"], "options": [{"window": ")" +
                        std::string(200, '0') + R"(64"}]}})"}}},
-      {"grid_too_large", "run --grid 100000x100000", "exceeds the limit of 2^30 nodes"},
+      {"grid_too_large", "run --grid 100000x100000", "--grid (cloth 100000x100000): a model of about 1e+10 nodes exceeds"},
       {"lattice_too_large", "run --lattice 2000x2000x2000", "exceeds the limit of 2^30 nodes"},
       // 2^22 x 2^21 x 2^21 nodes: 2^64, 0 in 64 bits
       {"lattice_past_64_bits", "run --lattice 4194304x2097152x2097152",
        "a model of about 1.84e+19 nodes exceeds the limit of 2^30 nodes"},
       scene("lattice_past_64_bits_in_a_scene", R"({"model": {"type": "lattice", "size": [4194304, 2097152, 2097152]}})",
-            "a model of about 1.84e+19 nodes exceeds the limit of 2^30 nodes"),
+            "s.json.model (lattice 4194304x2097152x2097152): a model of about 1.84e+19 nodes exceeds the limit"),
       {"host_memory", "run --pipeline reference --grid 32000x32000", "GiB of host memory"},
       {"out_is_a_file", "run --pipeline cpu --steps 3 --out {dir}/f.txt", "exists and is not a folder", {{"f.txt", "x"}}},
       {"out_empty", "run --pipeline cpu --steps 3 --out ''", "--out '': an empty path names no folder"},

@@ -48,8 +48,8 @@ TEST_F(Cli, ViewRefusesFlagsItCannotKeep) {
            {"--option window=4 --option tile=8x8", "--option: no pipeline has all of the options tile, window"},
            {"--option math=quick", "--option: no pipeline reads these values ("},
            {"--pipeline glsl-tf --integrator backward-euler", "integrator 'backward-euler' is not available on glsl-tf"},
-           {"--lattice 2000x2000x2000", "a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
-           {"--pipeline cpu --lattice 2000x2000x2000", "a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
+           {"--lattice 2000x2000x2000", "--lattice (lattice 2000x2000x2000): a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
+           {"--pipeline cpu --lattice 2000x2000x2000", "--lattice (lattice 2000x2000x2000): a model of about 8e+09 nodes exceeds the limit of 2^30 nodes"},
            {"--scene " + deep.string(), "node 1 starts 3 m below the ground, deeper than a step may move a node"},
            {"--scene " + outside.string(), outside.string() + ".drag.node: node 99 is outside the model (0..15)"}}) {
     const Result r = run("view " + args);
