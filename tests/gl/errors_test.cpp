@@ -131,8 +131,8 @@ TEST(GlErrors, ASoftwareRenderersBuffersAreCountedBeforeTheModelIsBuilt) {
   const Command c = run_deformlab("", "run -p glsl-tf --integrator semi-implicit-euler --grid " + grid +
                                           " --steps 1 --no-state -o '" + (dir / "out").string() + "'");
   EXPECT_EQ(c.exit_code, 2) << c.output;
-  EXPECT_TRUE(c.output.starts_with("deformlab: error: a model of " + std::to_string(std::int64_t(side) * side) +
-                                   " nodes on glsl-tf needs "))
+  EXPECT_TRUE(c.output.starts_with("deformlab: error: --grid (cloth " + grid + "): a model of " +
+                                   std::to_string(std::int64_t(side) * side) + " nodes on glsl-tf needs "))
       << c.output;
   EXPECT_NE(c.output.find(" of host memory (model "), std::string::npos) << c.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing is written";
