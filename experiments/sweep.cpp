@@ -291,6 +291,9 @@ json render_frames(const Experiment& x, const Sweep& s, const fs::path& dir) {
     j["drag_end_s"] = p.drag.end_time();
     j["files"] = files;
     return j;
+  } catch (const Interrupted&) {  // the experiment stops: its next run renders them
+    fs::remove_all(tmp);
+    throw;
   } catch (const std::exception& ex) {
     fs::remove_all(tmp);
     return {{"unavailable", std::string("rendering failed: ") + ex.what()}};
