@@ -101,7 +101,7 @@ void require_model_files(const Experiment& x, const Sweep& s) {
 
 Scene model_cell_scene(const Experiment& x, const Sweep& s, const Cell& c) {
   const auto m = std::find_if(s.models.begin(), s.models.end(), [&](const SweepModel& e) { return e.name == c.model; });
-  Scene scene = model_scene(x, s, m->model, model_key(s, c.model));
+  Scene scene = model_scene(x, s, m->model, model_key(s, std::size_t(m - s.models.begin())));
   if (!c.order.empty()) scene.model.mesh.order = *parse_node_order(c.order);
   return scene;
 }

@@ -31,10 +31,6 @@ namespace deformlab {
 
 namespace {
 
-[[noreturn]] void bad(const std::string& file, const std::string& what) {
-  throw std::invalid_argument("mesh file '" + file + "': " + what);
-}
-
 // What assimp refused, after "assimp:", its runs of spaces made one (it names a mesh without
 // a name as "Mesh  contains no faces").
 [[noreturn]] void refused_by_assimp(const std::string& file, const Assimp::Importer& importer) {
@@ -44,7 +40,7 @@ namespace {
   // assimp's words for an OBJ `f` line of one or two vertices among an object's polygons.
   if (why.find("is a LINE but") != std::string::npos || why.find("is a POINT but") != std::string::npos)
     why += " (a face of fewer than 3 vertices among polygons: an OBJ writes lines with `l`, points with `p`)";
-  bad(file, "assimp: " + why);
+  bad_mesh_file(file, "assimp: " + why);
 }
 
 // assimp also opens the files a mesh names (an OBJ's mtllib, a glTF's buffers): regular files
@@ -122,7 +118,7 @@ void append_object(const std::string& path, const aiScene& scene, const aiNode& 
       continue;
     }
     if (std::int64_t(p.size()) + a.mNumVertices > std::numeric_limits<std::int32_t>::max())
-      bad(path, "more than 2^31 vertices before joining those at one position");
+      bad_mesh_file(path, "more than 2^31 vertices before joining those at one position");
     at[k].assign(a.mNumVertices, -1);
     for (unsigned f = 0; f < a.mNumFaces; ++f)
       for (unsigned i = 0; i < 3; ++i) at[k][a.mFaces[f].mIndices[i]] = 0;
@@ -142,7 +138,7 @@ void append_object(const std::string& path, const aiScene& scene, const aiNode& 
       m.position.push_back(p[e]);
     }
   }
-  if (m.position.size() > (std::size_t(1) << 30)) bad(path, "more than 2^30 vertices");
+  if (m.position.size() > (std::size_t(1) << 30)) bad_mesh_file(path, "more than 2^30 vertices");
   for (unsigned k = 0; k < object.mNumMeshes; ++k) {
     const aiMesh& a = *scene.mMeshes[object.mMeshes[k]];
     if (at[k].empty()) continue;
@@ -206,12 +202,12 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
   if (!scene) refused_by_assimp(path, importer);
   if (!lost.first.empty()) {
     while (!lost.first.empty() && std::isspace(static_cast<unsigned char>(lost.first.back()))) lost.first.pop_back();
-    bad(path, "assimp: " + lost.first);
+    bad_mesh_file(path, "assimp: " + lost.first);
   }
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* a = scene->mMeshes[k];
     for (unsigned v = 0; v < a->mNumVertices; ++v)
-      if (const aiVector3D& p = a->mVertices[v]; !finite_vertex({p.x, p.y, p.z})) bad(path, non_finite_vertex({p.x, p.y, p.z}));
+      if (const Vec3f p = position_of(a->mVertices[v]); !finite_vertex(p)) bad_mesh_file(path, non_finite_vertex(p));
   }
   // Positions no face uses are left out below: counted here, an object at a time.
   std::int64_t unused = 0;
@@ -233,7 +229,7 @@ Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) 
     if (appended.insert(o).second) append_object(path, *scene, *o, m, points, lines);
   if (points || lines)
     notes.push_back("left out " + std::to_string(points) + " points and " + std::to_string(lines) + " lines");
-  if (m.triangle.empty()) bad(path, "no triangles");
+  if (m.triangle.empty()) bad_mesh_file(path, "no triangles");
   return m;
 }
 
@@ -373,12 +369,13 @@ Mesh read_gmsh_model(const std::string& what, std::vector<std::string>* notes) {
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   std::error_code ec;
   const auto st = std::filesystem::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) bad(path, ec.message());  // a link loop, a name too long
-  if (ec || !std::filesystem::exists(st)) bad(path, "no such file");
-  if (std::filesystem::is_directory(st)) bad(path, "a directory, not a mesh file");
-  if (!std::filesystem::is_regular_file(st)) bad(path, "not a regular file");
+  // A link loop, a name too long:
+  if (ec && ec != std::errc::no_such_file_or_directory) bad_mesh_file(path, ec.message());
+  if (ec || !std::filesystem::exists(st)) bad_mesh_file(path, "no such file");
+  if (std::filesystem::is_directory(st)) bad_mesh_file(path, "a directory, not a mesh file");
+  if (!std::filesystem::is_regular_file(st)) bad_mesh_file(path, "not a regular file");
   const auto size = std::filesystem::file_size(path, ec);
-  if (size == 0) bad(path, "the file is empty");
+  if (size == 0) bad_mesh_file(path, "the file is empty");
   const std::string what = "mesh file '" + path + "'";
   return read_in_child(what, child_read_limits(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
     if (extension_of(path) != ".msh") return load_with_assimp(path, read_notes);

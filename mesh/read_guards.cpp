@@ -13,7 +13,7 @@ namespace deformlab {
 namespace {
 
 [[noreturn]] void bad_line(const std::string& file, std::int64_t line, const std::string& what) {
-  throw std::invalid_argument("mesh file '" + file + "': line " + std::to_string(line) + ": " + what);
+  bad_mesh_file(file, "line " + std::to_string(line) + ": " + what);
 }
 
 bool blank(char c) { return c == ' ' || c == '\t'; }
@@ -53,6 +53,10 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
 
 }  // namespace
 
+void bad_mesh_file(const std::string& file, const std::string& what) {
+  throw std::invalid_argument("mesh file '" + file + "': " + what);
+}
+
 std::string extension_of(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -71,9 +75,7 @@ void require_ply_header_end(const std::string& path, const Assimp::Importer& imp
   const bool magic = head.starts_with("ply") || head.starts_with("PLY");
   const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
   if (ply && head.find("end_header") == std::string::npos)
-    throw std::invalid_argument("mesh file '" + path +
-                                "': its PLY header has no end_header line in its first 64 KiB (a truncated or "
-                                "damaged file)");
+    bad_mesh_file(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
 
 // A skipped `v` line gives the vertices after it the numbers before, so that faces join other

@@ -10,6 +10,9 @@ class Importer;
 
 namespace deformlab {
 
+// Throws std::invalid_argument("mesh file '<file>': <what>").
+[[noreturn]] void bad_mesh_file(const std::string& file, const std::string& what);
+
 // A file's extension in lower case (".PLY" and ".ply" name one format).
 std::string extension_of(const std::string& path);
 
