@@ -112,7 +112,7 @@ json compare_with_reference(const RunInput& in, const State& final_state, int st
   for (int s = 0; s < steps; ++s) {
     ref->step();
     if (const int sig = InterruptCatcher::caught())
-      throw Interrupted(sig, signal_name(sig) + " in --compare's reference run: the run stopped and wrote nothing");
+      throw Interrupted(sig, signal_name(sig) + " in --compare's reference run");
   }
   return {{"reference", "double-precision CPU (OpenMP)"},
           {"steps", steps},
@@ -293,6 +293,16 @@ void print_summary(const RunArgs& a, const RunInput& in, const Pipeline& pipe, c
             << (a.energy ? ", energy.csv" : "") << "}\n";
 }
 
+// f(), a signal that stops it said to leave the output folder as it was.
+template <class F>
+auto unless_interrupted(F&& f) {
+  try {
+    return f();
+  } catch (const Interrupted& e) {
+    throw Interrupted(e.signal, std::string(e.what()) + ": the run stopped and wrote nothing");
+  }
+}
+
 }  // namespace
 
 int run_command(const RunArgs& a) {
@@ -339,17 +349,12 @@ int run_command(const RunArgs& a) {
     // window of steps in kRunSampling (the step clock's median then comes from steps without
     // them, as in an experiment cell or the bench); a trace times every step.
     profiler.sample_every(a.trace ? 1 : kRunSampling);
-    const Ran ran = [&] {
-      try {
-        return run_pipeline(a, in, *pipe, profiler, dir);
-      } catch (const Interrupted& e) {
-        throw Interrupted(e.signal, std::string(e.what()) + ": the run stopped and wrote nothing");
-      }
-    }();
+    const Ran ran = unless_interrupted([&] { return run_pipeline(a, in, *pipe, profiler, dir); });
     profiler.end_stream();
     const RunResult& r = ran.result;
     const State final_state = pipe->state();
-    const json compare = a.compare ? compare_with_reference(in, final_state, r.steps) : json();
+    const json compare =
+        a.compare ? unless_interrupted([&] { return compare_with_reference(in, final_state, r.steps); }) : json();
     const StepMedians med = medians_of(r, profiler);
 
     write_timings_csv(dir.staged("timings.csv"), r);
