@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <set>
 #include <span>
 #include <stdexcept>
@@ -337,12 +338,13 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
       m.pins = PinSet::list;
       m.pin_list.clear();
       const json list = p.is_array() ? p : json::array({p});
-      std::set<int> seen;
+      std::map<json, std::size_t> seen;  // a selector written twice is a slip (differing ones may share nodes)
       for (std::size_t k = 0; k < list.size(); ++k) {
-        const std::string w = where + ".pins" + (p.is_array() ? "[" + std::to_string(k) + "]" : "");
+        std::string w = where + ".pins";
+        if (p.is_array()) w += '[' + std::to_string(k) + ']';
         m.pin_list.push_back(selector(list[k], w, false));
-        const int node = m.pin_list.back().index;
-        if (node >= 0 && !seen.insert(node).second) bad_value(w, "node " + std::to_string(node) + " is listed twice");
+        if (const auto [at, added] = seen.emplace(list[k], k); !added)
+          bad_value(w, "the same selector as pins[" + std::to_string(at->second) + "]");
       }
     } else {
       const auto s = p.is_string() ? p.get<std::string>() : "";
