@@ -296,7 +296,7 @@ void OutputDir::remove_created() const {
 
 OutputDir::~OutputDir() {
   std::error_code ec;
-  fs::remove_all(staging_, ec);
+  if (!keep_staging_) fs::remove_all(staging_, ec);
   remove_created();
 }
 
@@ -312,17 +312,27 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
     fs::rename(staging_, kept);
     throw std::runtime_error(std::string(e.what()) + "; this run's outputs are in '" + kept.string() + "'");
   }
-  fs::remove(dir_ / "manifest.json");  // from here until the last rename the folder is incomplete
-  for (const auto& name : earlier_)
-    if (!fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
-  for (const auto& e : fs::directory_iterator(staging_)) {
-    if (e.path().filename() == "manifest.json") continue;
-    const fs::path target = dir_ / e.path().filename();
-    if (fs::is_directory(e.path()) && fs::exists(target)) fs::remove_all(target);
-    fs::rename(e.path(), target);
-    if (moved) moved(target);
+  // From here until the last rename the folder is incomplete. Where a step fails, the staging
+  // folder stays for the next run here to finish the commit, as after a process stopped here.
+  keep_staging_ = true;
+  try {
+    fs::remove(dir_ / "manifest.json");
+    for (const auto& name : earlier_)
+      if (!fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
+    for (const auto& e : fs::directory_iterator(staging_)) {
+      if (e.path().filename() == "manifest.json") continue;
+      const fs::path target = dir_ / e.path().filename();
+      if (fs::is_directory(e.path()) && fs::exists(target)) fs::remove_all(target);
+      fs::rename(e.path(), target);
+      if (moved) moved(target);
+    }
+    if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
+  } catch (const fs::filesystem_error& e) {
+    throw std::runtime_error("cannot finish moving this run's outputs into '" + dir_.string() + "' (" +
+                             e.code().message() + "): the rest are in '" + staging_.string() +
+                             "', and the next run with this output folder moves them in first");
   }
-  if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
+  keep_staging_ = false;
 }
 
 namespace {

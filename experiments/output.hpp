@@ -76,8 +76,8 @@ class OutputDir {
   // already must be the earlier run's, else it is someone else's and std::invalid_argument is
   // thrown rather than replace it.
   OutputDir(const std::filesystem::path& dir, std::vector<std::string> outputs, const std::vector<std::string>& writes);
-  // Removes the staging folder, and the folders the constructor made (the output folder and
-  // any above it) that nothing was committed into.
+  // Removes the staging folder (unless a commit failed part way), and the folders the
+  // constructor made (the output folder and any above it) that nothing was committed into.
   ~OutputDir();
   OutputDir(const OutputDir&) = delete;
   OutputDir& operator=(const OutputDir&) = delete;
@@ -88,8 +88,10 @@ class OutputDir {
   // the old manifest.json is removed first, then the old output's files the new one lacks, and
   // the new manifest is moved in last. Where an entry of the other kind (file or folder) has
   // appeared in the way since, throws std::runtime_error with the folder as it was and the
-  // outputs moved to `dir`/unsaved-run-<pid>. `moved`, where given, is called after each
-  // entry but the manifest is moved into place, with its new path (a test stops a commit there).
+  // outputs moved to `dir`/unsaved-run-<pid>. Where a removal or rename fails part way, throws
+  // std::runtime_error and keeps the staging folder, which the next OutputDir of `dir` moves in.
+  // `moved`, where given, is called after each entry but the manifest is moved into place, with
+  // its new path (a test stops a commit there).
   void commit(const std::function<void(const std::filesystem::path&)>& moved = {});
   const std::filesystem::path& dir() const { return dir_; }
 
@@ -99,6 +101,7 @@ class OutputDir {
   void require_replaceable(const std::vector<std::string>& names) const;
   void require_ours(const std::vector<std::string>& writes) const;
   std::filesystem::path dir_, staging_;
+  bool keep_staging_ = false;  // a commit failed part way: the next run finishes it
   std::vector<std::string> outputs_;
   std::set<std::string> earlier_;  // of `outputs_`, those the folder's earlier run wrote
   std::vector<std::filesystem::path> created_;  // the folders the constructor made, the deepest first

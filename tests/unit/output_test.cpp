@@ -1,9 +1,9 @@
 // Run outputs (experiments/output.hpp): an entry of the other kind in an output's place is
 // refused before anything changes (after the run, with its outputs kept); a commit stopped
-// between its renames leaves a folder without a manifest, the mark of an incomplete run, and
-// the next run's commit completes it; a commit leaves none of the old output's files that the
-// new one lacks, and replaces nothing no run wrote; a folder holds one run or one experiment; a
-// failed write says why.
+// between its renames, or whose rename failed, leaves a folder without a manifest, the mark of
+// an incomplete run, and the next run's commit completes it; a commit leaves none of the old
+// output's files that the new one lacks, and replaces nothing no run wrote; a folder holds one
+// run or one experiment; a failed write says why.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -114,6 +114,40 @@ TEST(OutputDir, ACommitStoppedBetweenRenamesLeavesNoManifestAndTheNextCompletesI
   for (const char* f : {"manifest.json", "summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "newer") << f;
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().find(".deformlab-staging-"), std::string::npos) << "staging left behind";
+  fs::remove_all(dir);
+}
+
+// A rename that fails part way (a full or read-only file system) is not a stopped process: the
+// error says where the rest are, and the staging folder stays for the next run to move in.
+TEST(OutputDir, ACommitThatFailsPartWayKeepsTheRestForTheNextRun) {
+  const fs::path dir = fresh("deformlab-commit-failed");
+  write(dir / "manifest.json", R"({"experiment": "paper-drag"})");  // a run's
+  fs::path staging;
+  {
+    OutputDir out(dir, kOutputs, kWrites);
+    for (const char* f : {"summary.txt", "state.ply"}) write(out.staged(f), "new");
+    write(out.staged("manifest.json"), R"({"experiment": "new"})");
+    staging = out.staged("manifest.json").parent_path();
+    try {
+      out.commit([&](const fs::path& p) {
+        throw fs::filesystem_error("rename", p, std::make_error_code(std::errc::read_only_file_system));
+      });
+      ADD_FAILURE() << "committed";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "cannot finish moving this run's outputs into '" + dir.string() +
+                                           "' (Read-only file system): the rest are in '" +
+                                           staging.string() + "', and the next run with this output folder "
+                                           "moves them in first");
+    }
+  }
+  EXPECT_EQ(folder_holds(dir), Holds::nothing) << "an incomplete folder has no manifest";
+  EXPECT_EQ(read(staging / "manifest.json"), R"({"experiment": "new"})") << "the staging folder kept";
+  {
+    OutputDir out(dir, kOutputs, kWrites);  // finishes the failed commit first
+    EXPECT_EQ(read(dir / "manifest.json"), R"({"experiment": "new"})");
+    for (const char* f : {"summary.txt", "state.ply"}) EXPECT_EQ(read(dir / f), "new") << f;
+  }
+  EXPECT_FALSE(fs::exists(staging)) << "staging left behind";
   fs::remove_all(dir);
 }
 
