@@ -331,11 +331,11 @@ int run_command(const RunArgs& a) {
       std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
                 << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
                 << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
-    if (const double limit = damping_limit(in.model, in.params, in.integ); in.params.dt >= limit)
-      std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
-                << "'s bound for the global damping (damping = " << in.params.damping << " N s/m: dt < "
-                << significant(limit, 3) << " s at the lightest free node): each step grows the velocities it "
-                << "damps, and the run diverges\n";
+    if (in.params.dt >= damping_limit(in.model, in.params, in.integ))
+      std::cerr << "deformlab: note: " << damping_bound_passed(in.model, in.params, in.integ)
+                << ": each step can grow the velocities it damps, and then the run diverges\n";
+    if (const std::string loose = loose_stop_rule(in.model, in.params); in.until_converged && !loose.empty())
+      std::cerr << "deformlab: note: " << loose << "\n";
     if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
       std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
                 << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";

@@ -37,11 +37,25 @@ double stability_limit(const Model& m, const Params& p, Integrator i) {
   return std::numeric_limits<double>::infinity();
 }
 
+namespace {
+
+// Pinned, or hard-dragged (the node follows its path, not its velocity).
+bool fixed(const Model& m, const Params& p, int n) {
+  return m.inv_mass[n] == 0.f || (p.drag.active() && !p.drag.as_spring && n == p.drag.node);
+}
+
+}  // namespace
+
 double damping_limit(const Model& m, const Params& p, Integrator i) {
-  double inv_mass = 0.0;  // the lightest free node's (a hard-dragged node follows its path)
-  for (int n = 0; n < m.node_count(); ++n)
-    if (!(p.drag.active() && !p.drag.as_spring && n == p.drag.node)) inv_mass = std::max(inv_mass, double(m.inv_mass[n]));
-  const double gamma = double(p.damping) * inv_mass;
+  double gamma = 0.0;  // Gershgorin bound on the largest damping rate of a free node, 1/s
+  const int nodes = m.node_count();
+#pragma omp parallel for schedule(static) reduction(max : gamma)
+  for (int n = 0; n < nodes; ++n) {
+    if (fixed(m, p, n)) continue;
+    double c = p.damping;  // the global damping, and each spring's on its row and, to a free node, off it
+    for_each_link(m, n, [&](int w, float, float, float kd) { c += (fixed(m, p, w) ? 1.0 : 2.0) * kd; });
+    gamma = std::max(gamma, c * m.inv_mass[n]);
+  }
   // Where each scheme's factor on v' = -gamma v reaches 1 in size along gamma dt: -1 for the
   // Euler schemes, Verlet and RK3, +1 for midpoint and RK4.
   double reach = 2.0;
@@ -51,13 +65,22 @@ double damping_limit(const Model& m, const Params& p, Integrator i) {
   return reach / gamma;
 }
 
+std::string damping_bound_passed(const Model& m, const Params& p, Integrator i) {
+  const bool springs = std::ranges::any_of(m.damping, [](float kd) { return kd > 0.f; }) ||
+                       std::ranges::any_of(m.spring_damping, [](float kd) { return kd > 0.f; });
+  std::ostringstream os;
+  os << "dt = " << p.dt << " s is above " << info(i).name << "'s bound for the damping (global damping " << p.damping
+     << " N s/m" << (springs ? " and the springs' damping" : "") << ": dt < " << damping_limit(m, p, i)
+     << " s at the node damped fastest)";
+  return os.str();
+}
+
 std::string stability_hint(const Model& m, const Params& p, Integrator i) {
   const double limit = stability_limit(m, p, i);
   const std::string name(info(i).name);
   std::ostringstream os;
-  if (const double damped = damping_limit(m, p, i); p.dt >= damped) {
-    os << "dt = " << p.dt << " s is above " << name << "'s bound for the global damping (damping = " << p.damping
-       << " N s/m: dt < " << damped << " s at the lightest free node): each step grows the velocities it damps";
+  if (p.dt >= damping_limit(m, p, i)) {
+    os << damping_bound_passed(m, p, i) << ": each step can grow the velocities it damps";
   } else if (limit == 0.0) {
     os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable for dt < "
        << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
@@ -120,8 +143,26 @@ class StepTimes {
 
 }  // namespace
 
+namespace {
+
+// How far the constant fields alone move the free node they pull hardest in step `step` of a
+// fall from rest: |g + wind / m| dt^2 x step (semi-implicit Euler's; the other schemes' differ
+// by at most a step).
+double free_fall_step(const Model& m, const Params& p, int step) {
+  double a = 0.0;
+  for (int n = 0; n < m.node_count(); ++n)
+    if (!fixed(m, p, n)) a = std::max(a, norm(Vec3d(p.gravity) + Vec3d(p.wind) * double(m.inv_mass[n])));
+  return a * double(p.dt) * double(p.dt) * std::max(step, 1);
+}
+
+double runaway_distance(const Params& p, float extent) {
+  return double(p.runaway_factor) * std::max(double(extent), 1e-3);
+}
+
+}  // namespace
+
 std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t) {
-  const double runaway = double(p.runaway_factor) * std::max(double(extent), 1e-3);
+  const double runaway = runaway_distance(p, extent);
   if (std::isfinite(disp) && disp <= runaway) return {};
   std::ostringstream os;
   os << "diverged at step " << step << " (t = " << t << " s): ";
@@ -130,7 +171,25 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   else
     os << "a node moved " << disp << " m in one step, more than " << runaway
        << " m (runaway_factor x model extent, the extent counted as at least 1 mm)";
-  os << "; " << stability_hint(m, p, i);
+  if (const double fall = free_fall_step(m, p, step); fall > runaway)
+    os << "; gravity and wind alone move a free node falling from rest " << fall << " m at this step (|g + wind / m| "
+       << "dt^2 x step), more than the runaway distance " << runaway << " m: the field, not the step's stability, "
+       << "stopped the run (a larger runaway_factor admits motion that stays finite)";
+  else
+    os << "; " << stability_hint(m, p, i);
+  return os.str();
+}
+
+std::string loose_stop_rule(const Model& m, const Params& p) {
+  std::ostringstream os;
+  if (const double runaway = runaway_distance(p, m.extent()); p.threshold >= runaway)
+    os << "threshold = " << p.threshold << " m a step is at least the runaway distance " << runaway
+       << " m: every step that does not diverge passes the stop rule";
+  else if (const double fall = free_fall_step(m, p, p.max_steps); fall > 0.0 && p.threshold > fall)
+    os << "threshold = " << p.threshold << " m a step (" << p.threshold / p.dt << " m/s at dt = " << p.dt
+       << " s) is more than gravity and wind alone move a node falling from rest at any step up to max_steps ("
+       << fall << " m at step " << p.max_steps << "): unless springs or the drag move nodes faster, the stop rule "
+       << "holds at its first check";
   return os.str();
 }
 

@@ -22,12 +22,17 @@ namespace deformlab {
 // and damping move the true limit. Infinite for backward Euler and where no free node has a
 // spring; 0 for explicit Euler and midpoint, which amplify an undamped oscillation at any step.
 double stability_limit(const Model& m, const Params& p, Integrator i);
-// The largest time step for which `i` keeps the global damping (f = -c v) from growing the
-// velocity it damps: r m_min / c, r = 2 for the Euler schemes, midpoint and Verlet, 2.51 for
-// RK3 and 2.79 for RK4 (their stability intervals on the negative real axis), m_min the lightest
-// free node's mass (a hard-dragged node is not free); exact for a free node without springs.
-// Infinite without damping and for backward Euler.
+// The largest time step for which `i` keeps the damping from growing the velocities it damps:
+// r / gamma_max, r = 2 for the Euler schemes, midpoint and Verlet, 2.51 for RK3 and 2.79 for
+// RK4 (their stability intervals on the negative real axis), and gamma_max bounded above by
+// Gershgorin: the largest (c + the node's springs' kd, each twice where its other end is free) /
+// mass of a free node (pinned and hard-dragged nodes are not free), with c the global damping
+// (f = -c v) and kd a spring's along its axis. Exact for a free node without springs, one on a
+// spring to a fixed node, and two free nodes of one mass on a spring. Infinite without damping
+// and for backward Euler.
 double damping_limit(const Model& m, const Params& p, Integrator i);
+// "dt = ... s is above <i>'s bound for the damping (...)", naming the damping and the bound.
+std::string damping_bound_passed(const Model& m, const Params& p, Integrator i);
 // What a divergence message says about the step: the bound and where dt lies against it.
 std::string stability_hint(const Model& m, const Params& p, Integrator i);
 
@@ -37,6 +42,11 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i);
 // extent does not take every move for a runaway), else the message naming the step, what was seen
 // and the bound.
 std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t);
+
+// Empty, or why the stop rule passes whatever a run does: a threshold at or over the runaway
+// distance, or one that gravity and wind do not reach in max_steps of a fall from rest (a dt
+// too small for the threshold).
+std::string loose_stop_rule(const Model& m, const Params& p);
 
 class DivergenceError : public std::runtime_error {
  public:

@@ -72,18 +72,26 @@ void expect_sharp_bound(const Model& m, Params p, const State& s0, Integrator i,
   }
 }
 
-// Two free nodes on one spring: w^2 = 2k/m exactly, which is also the Gershgorin bound. Each
-// scheme with a bound stays bounded 2% below it and diverges 2% above it.
-TEST(Run, StabilityBoundIsSharpOnASingleSpring) {
+// Nodes 0 and 1, 10 cm apart, on one spring of stiffness k and damping kd; node 1 of inverse
+// mass 100 /kg, node 0 of `inv_mass0`.
+Model one_spring(float inv_mass0, float k, float kd) {
   Model m;
   m.rest_position = {{0.f, 1.f, 0.f}, {0.1f, 1.f, 0.f}};
-  m.inv_mass = {100.f, 100.f};
+  m.inv_mass = {inv_mass0, 100.f};
   m.spring_i = {0};
   m.spring_j = {1};
   m.rest_length = {0.1f};
   m.kind = {SpringKind::structural};
-  m.stiffness = {500.f, 500.f, 500.f};
+  m.stiffness = {k, k, k};
+  m.damping = {kd, 0.f, 0.f};
   m.build_adjacency();
+  return m;
+}
+
+// Two free nodes on one spring: w^2 = 2k/m exactly, which is also the Gershgorin bound. Each
+// scheme with a bound stays bounded 2% below it and diverges 2% above it.
+TEST(Run, StabilityBoundIsSharpOnASingleSpring) {
+  const Model m = one_spring(100.f, 500.f, 0.f);
   Params p;
   p.gravity = {};
   p.damping = 0.f;
@@ -119,7 +127,7 @@ TEST(Run, DampingBoundIsSharpOnAFreeNode) {
     const double reach = i == Integrator::rk3 ? 2.5127453266183286 : i == Integrator::rk4 ? 2.785293563405282 : 2.0;
     EXPECT_NEAR(limit, reach / 50.0, 1e-12) << info(i).name;
     expect_sharp_bound(m, p, s0, i, limit, [](const State& s) { return norm(s.v[0]) < 1e-3f; },
-                       "'s bound for the global damping");
+                       "'s bound for the damping (global damping 0.5 N s/m: dt < ");
   }
   EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::backward_euler)));
   p.drag = {0, {{0.f, {}}, {1.f, {}}}, false, 1.f};  // hard-dragged: the node follows its path, not its velocity
@@ -128,6 +136,74 @@ TEST(Run, DampingBoundIsSharpOnAFreeNode) {
   EXPECT_NEAR(damping_limit(m, p, Integrator::semi_implicit_euler), 2.0 / 50.0, 1e-12);
   p.damping = 0.f;
   EXPECT_TRUE(std::isinf(damping_limit(m, p, Integrator::semi_implicit_euler)));
+}
+
+// The springs' damping along their axis: on a spring between two free nodes of mass m the
+// stretch rate decays as u' = -(2 kd / m) u, on one to a pinned node as u' = -(kd / m) u; the
+// Gershgorin bound is exact on both, and sharp for each scheme as on a free node.
+TEST(Run, SpringDampingBoundIsSharpOnASpring) {
+  for (const bool pinned : {false, true}) {
+    // w^2 = 0.2 /s^2: the damping (gamma = 25 or 50 /s) sets the bound.
+    const Model m = one_spring(pinned ? 0.f : 100.f, 1e-3f, 0.25f);
+    Params p;
+    p.gravity = {};
+    p.damping = 0.f;
+    p.max_steps = 2000;
+    p.runaway_factor = 1e6f;
+    State s0 = rest_state(m);
+    s0.v[1] = {1.f, 0.f, 0.f};  // stretching at 1 m/s
+    const double gamma = pinned ? 25.0 : 50.0;
+    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet,
+                         Integrator::rk4}) {
+      const double limit = damping_limit(m, p, i);
+      EXPECT_NEAR(limit, (i == Integrator::rk4 ? 2.785293563405282 : 2.0) / gamma, 1e-9)
+          << info(i).name << (pinned ? " to a pinned node" : "");
+      expect_sharp_bound(m, p, s0, i, limit, [](const State& s) { return norm(s.v[1] - s.v[0]) < 1e-3f; },
+                         "'s bound for the damping (global damping 0 N s/m and the springs' damping: dt < ");
+    }
+  }
+}
+
+// A field that moves a node more than the runaway bound in a step is named as the cause, not
+// the stability bound.
+TEST(Run, AFieldTooStrongForTheRunawayCheckIsNamed) {
+  const Model m = test::small_cloth(6, 6);
+  Params p = test::small_params();
+  p.gravity = {0.f, -1e9f, 0.f};  // 4 km in the first step at dt = 2 ms
+  p.dt = 0.002f;
+  auto pipe = make_cpu_pipeline({m, p, Integrator::semi_implicit_euler}, Precision::f32, false);
+  try {
+    run(*pipe, m, p, {});
+    ADD_FAILURE() << "no DivergenceError";
+  } catch (const DivergenceError& e) {
+    EXPECT_EQ(e.step, 1);
+    const std::string what = e.what();
+    EXPECT_NE(what.find("gravity and wind alone move a free node falling from rest 4000 m at this step"),
+              std::string::npos) << what;
+    EXPECT_EQ(what.find(stability_hint(m, p, Integrator::semi_implicit_euler)), std::string::npos) << what;
+  }
+  p.gravity = {0.f, -9.81f, 0.f};  // an ordinary field: the stability bound is named
+  EXPECT_EQ(divergence(INFINITY, m.extent(), m, p, Integrator::semi_implicit_euler, 1, 0.0).find("gravity and wind"),
+            std::string::npos);
+}
+
+// A stop rule that any run passes is named: a threshold past the runaway distance, or a dt so
+// small that a free fall's steps stay under the threshold for all of max_steps.
+TEST(Run, AStopRuleThatAnyRunPassesIsNamed) {
+  const Model m = test::small_cloth(6, 6);
+  Params p = test::small_params();
+  EXPECT_EQ(loose_stop_rule(m, p), "") << "the tests' scene";
+  p.threshold = 1e30f;
+  EXPECT_NE(loose_stop_rule(m, p).find("is at least the runaway distance"), std::string::npos);
+  p.threshold = 1e-3f;
+  p.max_steps = 1000;
+  p.dt = float(std::sqrt(0.999e-3 / (9.81 * 1000)));  // the 1000th step of a fall moves 0.999 mm
+  EXPECT_NE(loose_stop_rule(m, p).find("at step 1000): unless springs"), std::string::npos) << loose_stop_rule(m, p);
+  p.dt = float(std::sqrt(1.001e-3 / (9.81 * 1000)));
+  EXPECT_EQ(loose_stop_rule(m, p), "");
+  p.gravity = {};
+  p.wind = {};
+  EXPECT_EQ(loose_stop_rule(m, p), "") << "no field: nothing to say";
 }
 
 TEST(Run, StopsWhenNoNodeMovesMoreThanTheThreshold) {
