@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -108,14 +109,16 @@ struct Reader {
     std::set_new_handler(nullptr);
     throw std::bad_alloc();
   });
-  const std::string cap = "the " + gib(limits.memory) + " of memory allowed for a file of its size";
+  const std::string cap = "the " + gib(limits.memory) + " of memory " +
+                          (limits.memory_set ? std::string(kReadMemoryVariable) + " allows" : "allowed for a file of its size");
+  const std::string raise = std::string("damaged counts? ") + kReadMemoryVariable + "=N allows N GiB";
   Writer out{fd};
   auto send = [&](const std::string& error) {
     out.bytes(&kError, 1);
     out.text(error);
   };
   auto fail = [&](const std::string& error) {
-    send(out_of_memory ? error + " (an allocation past " + cap + " failed before: damaged counts?)" : error);
+    send(out_of_memory ? error + " (an allocation past " + cap + " failed before: " + raise + ")" : error);
   };
   try {
     std::vector<std::string> notes;
@@ -130,7 +133,7 @@ struct Reader {
     out.count(notes.size());
     for (const auto& n : notes) out.text(n);
   } catch (const std::bad_alloc& e) {  // not past the cap: std::bad_array_new_length
-    if (out_of_memory) send(what + ": reading it took more than " + cap + " (damaged counts?)");
+    if (out_of_memory) send(what + ": reading it took more than " + cap + " (" + raise + ")");
     else fail(what + ": " + e.what());
   } catch (const std::exception& e) {
     fail(e.what());
@@ -163,7 +166,17 @@ struct ChildEnd {
 }  // namespace
 
 ChildLimits child_read_limits(std::int64_t file_bytes) {
-  return {std::max<std::int64_t>(std::int64_t(2) << 30, 64 * file_bytes), int(60 + 2 * (file_bytes >> 20))};
+  ChildLimits l{std::max<std::int64_t>(std::int64_t(2) << 30, 64 * file_bytes), int(60 + 2 * (file_bytes >> 20))};
+  if (const char* set = std::getenv(kReadMemoryVariable)) {
+    char* end = nullptr;
+    const double gib = std::strtod(set, &end);
+    if (end == set || *end != '\0' || !(gib > 0 && gib <= 1048576))
+      throw std::invalid_argument(std::string(kReadMemoryVariable) + " '" + set +
+                                  "': expected a number of GiB over 0 and at most 1048576");
+    l.memory = std::int64_t(gib * double(std::int64_t(1) << 30));
+    l.memory_set = true;
+  }
+  return l;
 }
 
 Mesh read_in_child(const std::string& what, ChildLimits limits,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -93,7 +94,7 @@ TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
   EXPECT_EQ(error.rfind("mesh file 'f': its reader stopped", 0), 0u) << error;
 #else
   EXPECT_EQ(error, "mesh file 'f': reading it took more than the 0.25 GiB of memory allowed for a file of its size "
-                   "(damaged counts?)");
+                   "(damaged counts? DEFORMLAB_MESH_READ_GIB=N allows N GiB)");
 #endif
   EXPECT_EQ(error_of({cap, 60}, [](std::vector<std::string>&) {
               Mesh m;
@@ -101,6 +102,39 @@ TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
               return m;
             }),
             "read");
+}
+
+// The cap follows the file's size unless DEFORMLAB_MESH_READ_GIB sets it; a value that is no
+// size is refused, naming the variable.
+TEST(ChildRead, TheMemoryCapCanBeSetByTheEnvironment) {
+  ::unsetenv(kReadMemoryVariable);
+  EXPECT_EQ(child_read_limits(1000).memory, std::int64_t(2) << 30);
+  EXPECT_EQ(child_read_limits(std::int64_t(100) << 20).memory, std::int64_t(6400) << 20);
+  EXPECT_FALSE(child_read_limits(1000).memory_set);
+  ::setenv(kReadMemoryVariable, "0.25", 1);
+  const ChildLimits set = child_read_limits(std::int64_t(100) << 20);
+  EXPECT_EQ(set.memory, std::int64_t(256) << 20);
+  EXPECT_TRUE(set.memory_set);
+#if !defined(__SANITIZE_ADDRESS__)  // its allocator ends the process where operator new would throw
+  EXPECT_EQ(error_of(set, [&](std::vector<std::string>&) -> Mesh {
+              Mesh m;
+              m.position.resize(std::size_t(2 * set.memory / sizeof(Vec3f)));
+              return m;
+            }),
+            "mesh file 'f': reading it took more than the 0.25 GiB of memory DEFORMLAB_MESH_READ_GIB allows (damaged "
+            "counts? DEFORMLAB_MESH_READ_GIB=N allows N GiB)");
+#endif
+  for (const char* bad : {"", "abc", "0", "-1", "2x", "inf", "nan", "2000000"}) {
+    ::setenv(kReadMemoryVariable, bad, 1);
+    try {
+      child_read_limits(1000);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(e.what(), "DEFORMLAB_MESH_READ_GIB '" + std::string(bad) +
+                              "': expected a number of GiB over 0 and at most 1048576");
+    }
+  }
+  ::unsetenv(kReadMemoryVariable);
 }
 
 // A library that catches the failed allocation and fails later in its own words: its error,
@@ -119,7 +153,7 @@ TEST(ChildRead, AnErrorAfterACaughtAllocationPastTheCapNamesBoth) {
               throw std::invalid_argument("mesh file 'f': no nodes");
             }),
             "mesh file 'f': no nodes (an allocation past the 0.25 GiB of memory allowed for a file of its size "
-            "failed before: damaged counts?)");
+            "failed before: damaged counts? DEFORMLAB_MESH_READ_GIB=N allows N GiB)");
 }
 
 TEST(ChildRead, AReaderPastItsCpuTimeIsStopped) {
