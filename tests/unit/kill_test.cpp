@@ -103,9 +103,10 @@ TEST_F(Cli, InterruptedRunSaysSoAndLeavesTheFolderAsItWas) {
 
 // A sweep stops between cells: those done are kept, and running it again measures the rest.
 TEST_F(Cli, InterruptedSweepKeepsItsCells) {
+  // About 4 s of cells on a 2-core machine: still running at the signal on a fast one.
   const fs::path file = write("stop.json", R"({"name": "stop", "base": "paper-drag", "integrator": "semi-implicit-euler",
     "sweep": {"sizes": [160, 192, 224, 256, 288, 320], "pipelines": ["cpu", "omp"],
-              "warmup": 2, "steps": 4, "repetitions": 3, "frames": 0}})");
+              "warmup": 2, "steps": 16, "repetitions": 3, "frames": 0}})");
   const fs::path out = dir_ / "sweep", err = dir_ / "err.txt";
   const std::string args = "experiment " + file.string() + " --out " + out.string();
   int status = 0;
