@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "core/number_text.hpp"
+#include "core/one_line.hpp"
 #include "experiments/output.hpp"
 #include "experiments/sweep_models.hpp"
 #include "mesh/scene_model.hpp"
@@ -57,6 +58,16 @@ void require_replaceable_mesh(const std::string& out, const MeshSpec& ms) {
                                 "$MeshFormat), which this would replace: remove it or name another file");
 }
 
+// The scene as it names the written mesh, in place of "generate" or of the fill and placement
+// already applied.
+Scene on_written_mesh(Scene s, const std::string& out) {
+  MeshSpec& ms = s.model.mesh;
+  if (ms.fill) ms = MeshSpec{.density = ms.density, .order = ms.order, .seed = ms.seed};
+  ms.generate.reset();
+  ms.file = out;
+  return s;
+}
+
 }  // namespace
 
 int mesh_command(const MeshArgs& a) {
@@ -91,6 +102,12 @@ int mesh_command(const MeshArgs& a) {
                              : counted(std::int64_t(m.triangle.size()), "triangle"))
               << ", made and written in " << duration_text(s) << " (host clock)\n"
               << "  wrote " << a.out << " (binary MSH 4.1, " << naming << " and every run reads this mesh\n";
+    // The mesh is the command's output whatever the rest of the scene; what a run would refuse is said.
+    try {
+      check_mesh_file(on_written_mesh(scene, a.out));
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "deformlab: note: a run of this scene on the mesh would refuse it: " << one_line(e.what()) << "\n";
+    }
     return 0;
   });
 }

@@ -212,6 +212,18 @@ TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   EXPECT_NE(r.out.find(": " + nodes + " nodes, "), std::string::npos) << r.out;
 }
 
+// The mesh is written whatever the scene's pins and drag; what a run on it would refuse is noted.
+TEST_F(Cli, MeshNotesWhatARunOfTheSceneWouldRefuse) {
+  write("s.json", R"({"model": {"type": "mesh", "pins": [{"box": [[5, 5, 5], [6, 6, 6]]}],
+                                "generate": {"shape": "sheet", "size": [0.2, 0.1], "cell_size": 0.05}}})");
+  const fs::path file = dir_ / "m.msh";
+  const Result made = run("mesh --scene " + (dir_ / "s.json").string() + " --out " + file.string());
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_TRUE(fs::is_regular_file(file));
+  EXPECT_EQ(made.err, "deformlab: note: a run of this scene on the mesh would refuse it: " + (dir_ / "s.json").string() +
+                          ".model.pins[0]: the box holds no node of the model\n");
+}
+
 // A filled surface (the bunny-soft scene's) written out: a scene naming the file without "fill",
 // "scale" and "transform" runs on the nodes the command counted.
 TEST_F(Cli, MeshWritesAFilledMeshThatARunReads) {
@@ -223,6 +235,7 @@ TEST_F(Cli, MeshWritesAFilledMeshThatARunReads) {
   const int node_count = mesh_nodes(made.out);
   EXPECT_GT(node_count, 1839) << made.out;  // the surface's nodes and the interior's
   EXPECT_NE(made.out.find("tetrahedra, made and written in"), std::string::npos) << made.out;
+  EXPECT_EQ(made.err, "") << "the scene's pins and drag node hold on the placed mesh";
   write("s.json", R"({"model": {"type": "mesh", "pins": "none", "file": "soft.msh"}})");
   const Result r = run("run --pipeline cpu --steps 3 --no-state --scene " + (dir_ / "s.json").string() + " --out " +
                        (dir_ / "run").string());
