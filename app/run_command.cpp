@@ -326,16 +326,11 @@ int run_command(const RunArgs& a) {
                 << "every " << in.params.check_every << " step(s) launches the steps held at each check, fewer at a "
                 << "time, and waits for them (--check-every " << k << " or a multiple of it keeps every launch whole "
                 << "and reads each check while the next launch runs)\n";
-    // 0: no step is stable undamped (explicit Euler, midpoint), which the integrator's notes say.
-    if (const double limit = stability_limit(in.model, in.params, in.integ); limit > 0 && in.params.dt > limit)
-      std::cerr << "deformlab: note: dt = " << in.params.dt << " s is above " << info(in.integ).name
-                << "'s stability bound on this model's linearised springs (" << significant(limit, 3)
-                << " s): a step under it is stable; over it, damping may keep the run stable or it diverges\n";
-    if (in.params.dt >= damping_limit(in.model, in.params, in.integ))
-      std::cerr << "deformlab: note: " << damping_bound_passed(in.model, in.params, in.integ)
-                << ": each step can grow the velocities it damps, and then the run diverges\n";
-    if (const std::string loose = loose_stop_rule(in.model, in.params); in.until_converged && !loose.empty())
-      std::cerr << "deformlab: note: " << loose << "\n";
+    if (const std::string passed = step_bound_passed(in.model, in.params, in.integ); !passed.empty())
+      std::cerr << "deformlab: note: " << passed << ": the run may diverge\n";
+    if (in.until_converged)
+      if (const std::string loose = loose_stop_rule(in.model, in.params); !loose.empty())
+        std::cerr << "deformlab: note: " << loose << "\n";
     if (in.until_converged && first_stop_step(in.params) > in.params.max_steps)
       std::cerr << "deformlab: note: " << stop_rule_start(in.params) << ", after max_steps ("
                 << in.params.max_steps << "): this run takes " << in.params.max_steps << " steps and cannot converge\n";

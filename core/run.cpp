@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -13,30 +14,6 @@
 
 namespace deformlab {
 
-double stability_limit(const Model& m, const Params& p, Integrator i) {
-  double w2 = 0.0;  // Gershgorin bound on the largest squared angular frequency
-  const int nodes = m.node_count();
-#pragma omp parallel for schedule(static) reduction(max : w2)
-  for (int n = 0; n < nodes; ++n) {
-    if (m.inv_mass[n] == 0.f) continue;
-    double k = 0.0;
-    for_each_link(m, n, [&](int, float, float ks, float) { k += 2.0 * ks; });
-    if (p.drag.active() && p.drag.as_spring && n == p.drag.node) k += p.drag.stiffness;
-    w2 = std::max(w2, k * m.inv_mass[n]);
-  }
-  const double w = std::sqrt(w2);
-  switch (i) {
-    case Integrator::semi_implicit_euler:
-    case Integrator::verlet: return 2.0 / w;
-    case Integrator::rk3: return std::sqrt(3.0) / w;
-    case Integrator::rk4: return 2.0 * std::sqrt(2.0) / w;
-    case Integrator::explicit_euler:
-    case Integrator::midpoint: return w > 0 ? 0.0 : std::numeric_limits<double>::infinity();
-    case Integrator::backward_euler: break;
-  }
-  return std::numeric_limits<double>::infinity();
-}
-
 namespace {
 
 // Pinned, or hard-dragged (the node follows its path, not its velocity).
@@ -44,54 +21,110 @@ bool fixed(const Model& m, const Params& p, int n) {
   return m.inv_mass[n] == 0.f || (p.drag.active() && !p.drag.as_spring && n == p.drag.node);
 }
 
-}  // namespace
-
-double damping_limit(const Model& m, const Params& p, Integrator i) {
-  double gamma = 0.0;  // Gershgorin bound on the largest damping rate of a free node, 1/s
+// Gershgorin bounds over the free nodes' rows of the linearised model: w2 on the largest squared
+// angular frequency of the springs (and a drag spring), gamma on the largest damping rate (the
+// global damping's and the springs'). A spring counts on its node's row, and again off it where
+// its other end is free.
+struct Rates {
+  double w2 = 0.0, gamma = 0.0;
+};
+Rates rates(const Model& m, const Params& p) {
+  double w2 = 0.0, gamma = 0.0;
   const int nodes = m.node_count();
-#pragma omp parallel for schedule(static) reduction(max : gamma)
+#pragma omp parallel for schedule(static) reduction(max : w2, gamma)
   for (int n = 0; n < nodes; ++n) {
     if (fixed(m, p, n)) continue;
-    double c = p.damping;  // the global damping, and each spring's on its row and, to a free node, off it
-    for_each_link(m, n, [&](int w, float, float, float kd) { c += (fixed(m, p, w) ? 1.0 : 2.0) * kd; });
+    double k = 0.0, c = p.damping;
+    for_each_link(m, n, [&](int w, float, float ks, float kd) {
+      const double terms = fixed(m, p, w) ? 1.0 : 2.0;
+      k += terms * ks;
+      c += terms * kd;
+    });
+    if (p.drag.active() && p.drag.as_spring && n == p.drag.node) k += p.drag.stiffness;
+    w2 = std::max(w2, k * m.inv_mass[n]);
     gamma = std::max(gamma, c * m.inv_mass[n]);
   }
+  return {w2, gamma};
+}
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+double springs_bound(const Rates& r, Integrator i) {
+  const double w = std::sqrt(r.w2);
+  switch (i) {
+    case Integrator::semi_implicit_euler:
+    case Integrator::verlet: return 2.0 / w;
+    case Integrator::rk3: return std::sqrt(3.0) / w;
+    case Integrator::rk4: return 2.0 * std::sqrt(2.0) / w;
+    case Integrator::explicit_euler:
+    case Integrator::midpoint: return w > 0 ? 0.0 : kInfinity;
+    case Integrator::backward_euler: break;
+  }
+  return kInfinity;
+}
+
+double damping_bound(const Rates& r, Integrator i) {
   // Where each scheme's factor on v' = -gamma v reaches 1 in size along gamma dt: -1 for the
   // Euler schemes, Verlet and RK3, +1 for midpoint and RK4.
   double reach = 2.0;
   if (i == Integrator::rk3) reach = 2.5127453266183286;  // root of z^3 - 3z^2 + 6z - 12
   if (i == Integrator::rk4) reach = 2.785293563405282;   // root of z^3 - 4z^2 + 12z - 24
-  if (i == Integrator::backward_euler || gamma == 0.0) return std::numeric_limits<double>::infinity();
-  return reach / gamma;
+  if (i == Integrator::backward_euler || r.gamma == 0.0) return kInfinity;
+  return reach / r.gamma;
 }
 
-std::string damping_bound_passed(const Model& m, const Params& p, Integrator i) {
-  const bool springs = std::ranges::any_of(m.damping, [](float kd) { return kd > 0.f; }) ||
-                       std::ranges::any_of(m.spring_damping, [](float kd) { return kd > 0.f; });
+// Semi-implicit Euler and Verlet on x'' = -w^2 x - gamma x' stay bounded while
+// w^2 dt^2 + 2 gamma dt < 4 (Jury's conditions on the step's matrix), the root in dt here.
+double together_bound(const Rates& r, Integrator i) {
+  if (i != Integrator::semi_implicit_euler && i != Integrator::verlet) return kInfinity;
+  if (r.w2 == 0.0) return r.gamma > 0.0 ? 2.0 / r.gamma : kInfinity;
+  return (std::sqrt(r.gamma * r.gamma + 4.0 * r.w2) - r.gamma) / r.w2;
+}
+
+}  // namespace
+
+double stability_limit(const Model& m, const Params& p, Integrator i) { return springs_bound(rates(m, p), i); }
+double damping_limit(const Model& m, const Params& p, Integrator i) { return damping_bound(rates(m, p), i); }
+double damped_stability_limit(const Model& m, const Params& p, Integrator i) {
+  return together_bound(rates(m, p), i);
+}
+
+std::string step_bound_passed(const Model& m, const Params& p, Integrator i) {
+  const Rates r = rates(m, p);
+  const auto bound = [](double v) {
+    std::ostringstream os;
+    os << std::setprecision(3) << v;
+    return os.str();
+  };
   std::ostringstream os;
-  os << "dt = " << p.dt << " s is above " << info(i).name << "'s bound for the damping (global damping " << p.damping
-     << " N s/m" << (springs ? " and the springs' damping" : "") << ": dt < " << damping_limit(m, p, i)
-     << " s at the node damped fastest)";
+  os << "dt = " << p.dt << " s is above " << info(i).name;
+  if (const double d = damping_bound(r, i); p.dt >= d)
+    os << "'s bound for the damping (global damping " << p.damping << " N s/m"
+       << (m.damped() ? " and the springs' damping" : "") << ": dt < " << bound(d)
+       << " s at the node damped fastest): each step can grow the velocities it damps";
+  else if (const double k = springs_bound(r, i); k > 0.0 && p.dt >= k)
+    os << "'s stability bound dt < " << bound(k) << " s on this model's linearised springs";
+  else if (const double t = together_bound(r, i); p.dt >= t)
+    os << "'s bound for the springs and the damping together (dt < " << bound(t)
+       << " s, where w^2 dt^2 + 2 gamma dt = 4 on the linearised model; each alone allows a longer step)";
+  else
+    return "";
   return os.str();
 }
 
 std::string stability_hint(const Model& m, const Params& p, Integrator i) {
+  if (std::string passed = step_bound_passed(m, p, i); !passed.empty()) return passed;
   const double limit = stability_limit(m, p, i);
   const std::string name(info(i).name);
   std::ostringstream os;
-  if (p.dt >= damping_limit(m, p, i)) {
-    os << damping_bound_passed(m, p, i) << ": each step can grow the velocities it damps";
-  } else if (limit == 0.0) {
-    os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable for dt < "
-       << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
+  if (limit == 0.0) {
+    os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable "
+       << "for dt < " << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
   } else if (std::isinf(limit)) {
     os << name << " is stable at any dt on the linearised springs: stretching or contact made it diverge";
-  } else if (p.dt >= limit) {
-    os << "dt = " << p.dt << " s is above " << name << "'s stability bound dt < " << limit
-       << " s on this model's linearised springs";
   } else {
-    os << "dt = " << p.dt << " s is below " << name << "'s stability bound " << limit
-       << " s on the linearised springs: stretching, contact or a stiff drag made it diverge";
+    os << "dt = " << p.dt << " s is below " << name << "'s bounds on the linearised springs and damping ("
+       << std::min(limit, damped_stability_limit(m, p, i)) << " s): stretching, contact or a stiff drag made it diverge";
   }
   return os.str();
 }
@@ -145,14 +178,23 @@ class StepTimes {
 
 namespace {
 
-// How far the constant fields alone move the free node they pull hardest in step `step` of a
-// fall from rest: |g + wind / m| dt^2 x step (semi-implicit Euler's; the other schemes' differ
-// by at most a step).
+// How far gravity and wind alone move a free node in step `step` of a fall from rest, the
+// farthest over the free nodes: semi-implicit Euler's v_k = (1 - gamma dt) v_(k-1) + a dt moves
+// it a dt^2 (1 - q^k) / (1 - q), q = 1 - gamma dt, in step k (k a dt^2 undamped), with
+// a = |g + wind / m| and gamma = c / m of the global damping (a uniform fall stretches no
+// spring); the other schemes differ by at most a step. 0 where the global damping grows a
+// velocity (q <= -1): that, not the fall, is what a run meets.
 double free_fall_step(const Model& m, const Params& p, int step) {
-  double a = 0.0;
-  for (int n = 0; n < m.node_count(); ++n)
-    if (!fixed(m, p, n)) a = std::max(a, norm(Vec3d(p.gravity) + Vec3d(p.wind) * double(m.inv_mass[n])));
-  return a * double(p.dt) * double(p.dt) * std::max(step, 1);
+  const double dt = p.dt, k = std::max(step, 1);
+  double far = 0.0;
+  for (int n = 0; n < m.node_count(); ++n) {
+    if (fixed(m, p, n)) continue;
+    const double a = norm(Vec3d(p.gravity) + Vec3d(p.wind) * double(m.inv_mass[n]));
+    const double q = 1.0 - double(p.damping) * m.inv_mass[n] * dt;
+    if (q <= -1.0) return 0.0;
+    far = std::max(far, a * dt * dt * (q == 1.0 ? k : (1.0 - std::pow(q, k)) / (1.0 - q)));
+  }
+  return far;
 }
 
 double runaway_distance(const Params& p, float extent) {
@@ -167,16 +209,19 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   std::ostringstream os;
   os << "diverged at step " << step << " (t = " << t << " s): ";
   if (!std::isfinite(disp))
-    os << "a position or velocity is not finite";
+    os << "a position, a velocity or a node's move in the step is not finite in float";
   else
     os << "a node moved " << disp << " m in one step, more than " << runaway
        << " m (runaway_factor x model extent, the extent counted as at least 1 mm)";
-  if (const double fall = free_fall_step(m, p, step); fall > runaway)
-    os << "; gravity and wind alone move a free node falling from rest " << fall << " m at this step (|g + wind / m| "
-       << "dt^2 x step), more than the runaway distance " << runaway << " m: the field, not the step's stability, "
-       << "stopped the run (a larger runaway_factor admits motion that stays finite)";
-  else
+  const double fall = free_fall_step(m, p, step);
+  if (fall <= runaway) {
     os << "; " << stability_hint(m, p, i);
+    return os.str();
+  }
+  os << "; gravity and wind alone move a free node falling from rest " << fall << " m at this step, more than the "
+     << "runaway distance " << runaway << " m: the field stopped the run";
+  if (std::isfinite(disp)) os << " (a larger runaway_factor admits the fall)";
+  if (const std::string passed = step_bound_passed(m, p, i); !passed.empty()) os << "; also, " << passed;
   return os.str();
 }
 

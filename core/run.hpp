@@ -13,26 +13,31 @@
 
 namespace deformlab {
 
-// The largest time step for which `i` keeps the model's springs, linearised at rest and
-// undamped, from growing: c / w_max, with c = 2 for the symplectic schemes (semi-implicit
-// Euler, Verlet), sqrt(3) for RK3 and 2 sqrt(2) for RK4 (where their stability regions
-// cross the imaginary axis), and w_max^2 bounded above by Gershgorin: the largest
-// (2 x incident stiffness + drag spring) / mass of a free node. So a step below it is stable
-// on the linearised model (the bound is exact for a single free spring); stretching, contact
-// and damping move the true limit. Infinite for backward Euler and where no free node has a
-// spring; 0 for explicit Euler and midpoint, which amplify an undamped oscillation at any step.
+// The bounds below are Gershgorin's, over the rows of the free nodes (not pinned, not
+// hard-dragged) of the model linearised at rest: a spring's stiffness or damping counts on its
+// node's row, and again off it where its other end is free. They are exact on a free node alone,
+// one on a spring to a fixed node and two free nodes of one mass on a spring, conservative
+// elsewhere (on a grid a step some way over one may still be stable).
+//
+// The largest time step for which `i` keeps the undamped springs from growing: c / w_max, with
+// c = 2 for the symplectic schemes (semi-implicit Euler, Verlet), sqrt(3) for RK3 and 2 sqrt(2)
+// for RK4 (where their stability regions cross the imaginary axis), and w_max^2 the largest
+// (stiffness terms + drag spring) / mass. Infinite for backward Euler and where no free node has
+// a spring; 0 for explicit Euler and midpoint, which amplify an undamped oscillation at any step.
 double stability_limit(const Model& m, const Params& p, Integrator i);
 // The largest time step for which `i` keeps the damping from growing the velocities it damps:
 // r / gamma_max, r = 2 for the Euler schemes, midpoint and Verlet, 2.51 for RK3 and 2.79 for
-// RK4 (their stability intervals on the negative real axis), and gamma_max bounded above by
-// Gershgorin: the largest (c + the node's springs' kd, each twice where its other end is free) /
-// mass of a free node (pinned and hard-dragged nodes are not free), with c the global damping
-// (f = -c v) and kd a spring's along its axis. Exact for a free node without springs, one on a
-// spring to a fixed node, and two free nodes of one mass on a spring. Infinite without damping
-// and for backward Euler.
+// RK4 (their stability intervals on the negative real axis), gamma_max the largest (c + the
+// springs' damping terms) / mass, c the global damping (f = -c v). Infinite without damping and
+// for backward Euler.
 double damping_limit(const Model& m, const Params& p, Integrator i);
-// "dt = ... s is above <i>'s bound for the damping (...)", naming the damping and the bound.
-std::string damping_bound_passed(const Model& m, const Params& p, Integrator i);
+// Semi-implicit Euler's and Verlet's bound with the springs and the damping together, where
+// w_max^2 dt^2 + 2 gamma_max dt = 4: under both of the above, and under each alone where the
+// other is 0. Infinite for the other schemes.
+double damped_stability_limit(const Model& m, const Params& p, Integrator i);
+// Empty, or "dt = ... s is above <i>'s bound ..." naming the first of the three bounds that dt
+// reaches (the damping's, the springs', both together) and its value.
+std::string step_bound_passed(const Model& m, const Params& p, Integrator i);
 // What a divergence message says about the step: the bound and where dt lies against it.
 std::string stability_hint(const Model& m, const Params& p, Integrator i);
 

@@ -72,6 +72,16 @@ void expect_sharp_bound(const Model& m, Params p, const State& s0, Integrator i,
   }
 }
 
+// Params without gravity, with global damping `damping`, for `max_steps` steps.
+Params field_free(float damping, int max_steps, float runaway_factor = 1.f) {
+  Params p;
+  p.gravity = {};
+  p.damping = damping;
+  p.max_steps = max_steps;
+  p.runaway_factor = runaway_factor;
+  return p;
+}
+
 // Nodes 0 and 1, 10 cm apart, on one spring of stiffness k and damping kd; node 1 of inverse
 // mass 100 /kg, node 0 of `inv_mass0`.
 Model one_spring(float inv_mass0, float k, float kd) {
@@ -92,10 +102,7 @@ Model one_spring(float inv_mass0, float k, float kd) {
 // scheme with a bound stays bounded 2% below it and diverges 2% above it.
 TEST(Run, StabilityBoundIsSharpOnASingleSpring) {
   const Model m = one_spring(100.f, 500.f, 0.f);
-  Params p;
-  p.gravity = {};
-  p.damping = 0.f;
-  p.max_steps = 4000;
+  const Params p = field_free(0.f, 4000);
   State s0 = rest_state(m);
   s0.x[1].x += 1e-3f;  // stretched 1 mm
   for (Integrator i : {Integrator::semi_implicit_euler, Integrator::verlet, Integrator::rk3, Integrator::rk4}) {
@@ -114,11 +121,9 @@ TEST(Run, DampingBoundIsSharpOnAFreeNode) {
   m.rest_position = {{0.f, 1.f, 0.f}};
   m.inv_mass = {100.f};
   m.build_adjacency();
-  Params p;
-  p.gravity = {};
-  p.damping = 0.5f;  // c/m = 50 /s
-  p.max_steps = 2000;
-  p.runaway_factor = 1e6f;  // 1 km a step: the first steps at 1 m/s move 4 cm, more than the 1 mm a point's extent allows
+  // c/m = 50 /s; 1 km a step: the first steps at 1 m/s move 4 cm, more than the 1 mm a point's
+  // extent allows.
+  Params p = field_free(0.5f, 2000, 1e6f);
   State s0 = rest_state(m);
   s0.v[0] = {1.f, 0.f, 0.f};
   for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
@@ -145,27 +150,45 @@ TEST(Run, SpringDampingBoundIsSharpOnASpring) {
   for (const bool pinned : {false, true}) {
     // w^2 = 0.2 /s^2: the damping (gamma = 25 or 50 /s) sets the bound.
     const Model m = one_spring(pinned ? 0.f : 100.f, 1e-3f, 0.25f);
-    Params p;
-    p.gravity = {};
-    p.damping = 0.f;
-    p.max_steps = 2000;
-    p.runaway_factor = 1e6f;
+    const Params p = field_free(0.f, 2000, 1e6f);
     State s0 = rest_state(m);
     s0.v[1] = {1.f, 0.f, 0.f};  // stretching at 1 m/s
     const double gamma = pinned ? 25.0 : 50.0;
-    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet,
-                         Integrator::rk4}) {
+    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::midpoint,
+                         Integrator::verlet, Integrator::rk3, Integrator::rk4}) {
       const double limit = damping_limit(m, p, i);
-      EXPECT_NEAR(limit, (i == Integrator::rk4 ? 2.785293563405282 : 2.0) / gamma, 1e-9)
-          << info(i).name << (pinned ? " to a pinned node" : "");
+      const double reach = i == Integrator::rk3 ? 2.5127453266183286 : i == Integrator::rk4 ? 2.785293563405282 : 2.0;
+      EXPECT_NEAR(limit, reach / gamma, 1e-9) << info(i).name << (pinned ? " to a pinned node" : "");
       expect_sharp_bound(m, p, s0, i, limit, [](const State& s) { return norm(s.v[1] - s.v[0]) < 1e-3f; },
                          "'s bound for the damping (global damping 0 N s/m and the springs' damping: dt < ");
     }
   }
 }
 
-// A field that moves a node more than the runaway bound in a step is named as the cause, not
-// the stability bound.
+// Stiff and damped at once: on two free nodes on one spring, u'' = -w^2 u - gamma u' with
+// w^2 = 2k/m = 1e5 /s^2 and gamma = 2 kd/m = 50 /s exactly, so semi-implicit Euler's and
+// Verlet's bound w^2 dt^2 + 2 gamma dt = 4 (5.84 ms) is sharp, under each bound alone (6.32 ms
+// for the springs, 40 ms for the damping).
+TEST(Run, SpringsAndDampingTogetherBoundIsSharpOnASpring) {
+  const Model m = one_spring(100.f, 500.f, 0.25f);
+  // 1 cm a step: growing, the stretch passes it within 10 steps, before the spring's nonlinearity
+  // (a stretch like its length) bounds it; decaying from 1 mm, no node moves 2 mm a step.
+  const Params p = field_free(0.f, 4000, 0.1f);
+  State s0 = rest_state(m);
+  s0.x[1].x += 1e-3f;  // stretched 1 mm
+  for (Integrator i : {Integrator::semi_implicit_euler, Integrator::verlet}) {
+    const double limit = damped_stability_limit(m, p, i);
+    EXPECT_NEAR(limit, (std::sqrt(50.0 * 50.0 + 4e5) - 50.0) / 1e5, 1e-9) << info(i).name;
+    EXPECT_LT(limit, stability_limit(m, p, i));
+    expect_sharp_bound(m, p, s0, i, limit, [](const State& s) { return std::abs(s.x[1].x - s.x[0].x - 0.1f) < 1e-3f; },
+                       "'s bound for the springs and the damping together (dt < 0.00584 s");
+  }
+  EXPECT_TRUE(std::isinf(damped_stability_limit(m, p, Integrator::rk4))) << "derived for the symplectic pair only";
+}
+
+// A field that moves a free node falling from rest more than the runaway distance in the step
+// that tripped the check is named as the cause; global damping slows the fall to its terminal
+// step a dt / gamma, and an ordinary field leaves the stability bound named.
 TEST(Run, AFieldTooStrongForTheRunawayCheckIsNamed) {
   const Model m = test::small_cloth(6, 6);
   Params p = test::small_params();
@@ -180,15 +203,33 @@ TEST(Run, AFieldTooStrongForTheRunawayCheckIsNamed) {
     const std::string what = e.what();
     EXPECT_NE(what.find("gravity and wind alone move a free node falling from rest 4000 m at this step"),
               std::string::npos) << what;
+    EXPECT_NE(what.find("the field stopped the run (a larger runaway_factor admits the fall)"), std::string::npos)
+        << what;
     EXPECT_EQ(what.find(stability_hint(m, p, Integrator::semi_implicit_euler)), std::string::npos) << what;
   }
-  p.gravity = {0.f, -9.81f, 0.f};  // an ordinary field: the stability bound is named
-  EXPECT_EQ(divergence(INFINITY, m.extent(), m, p, Integrator::semi_implicit_euler, 1, 0.0).find("gravity and wind"),
+  const Integrator semi = Integrator::semi_implicit_euler;
+  const double runaway = double(p.runaway_factor) * m.extent();  // 0.35 m
+  // Not finite: the field named, without runaway_factor's help.
+  const std::string overflow = divergence(INFINITY, m.extent(), m, p, semi, 1, 0.0);
+  EXPECT_NE(overflow.find("not finite in float; gravity and wind alone"), std::string::npos) << overflow;
+  EXPECT_EQ(overflow.find("runaway_factor admits"), std::string::npos) << overflow;
+  // g = 1e3 at dt = 2 ms: step 1000 of an undamped fall moves 4 m; damped at gamma = 100 /s,
+  // 2 cm (a dt / gamma): under the runaway distance, so the stability bound is named.
+  p.gravity = {0.f, -1e3f, 0.f};
+  ASSERT_GT(4.0, 2 * runaway);
+  p.damping = 0.f;
+  EXPECT_NE(divergence(2 * runaway, m.extent(), m, p, semi, 1000, 0.0).find("falling from rest 4 m at this step"),
             std::string::npos);
+  p.damping = 1.f;  // 0.01 kg a node: gamma = 100 /s
+  EXPECT_EQ(divergence(2 * runaway, m.extent(), m, p, semi, 1000, 0.0).find("gravity and wind"), std::string::npos);
+  p.damping = 0.02f;
+  p.gravity = {0.f, -9.81f, 0.f};
+  EXPECT_EQ(divergence(INFINITY, m.extent(), m, p, semi, 1, 0.0).find("gravity and wind"), std::string::npos);
 }
 
 // A stop rule that any run passes is named: a threshold past the runaway distance, or a dt so
-// small that a free fall's steps stay under the threshold for all of max_steps.
+// small that a free fall's steps stay under the threshold for all of max_steps (damped: under
+// its terminal step a dt / gamma).
 TEST(Run, AStopRuleThatAnyRunPassesIsNamed) {
   const Model m = test::small_cloth(6, 6);
   Params p = test::small_params();
@@ -197,10 +238,16 @@ TEST(Run, AStopRuleThatAnyRunPassesIsNamed) {
   EXPECT_NE(loose_stop_rule(m, p).find("is at least the runaway distance"), std::string::npos);
   p.threshold = 1e-3f;
   p.max_steps = 1000;
+  p.damping = 0.f;
   p.dt = float(std::sqrt(0.999e-3 / (9.81 * 1000)));  // the 1000th step of a fall moves 0.999 mm
   EXPECT_NE(loose_stop_rule(m, p).find("at step 1000): unless springs"), std::string::npos) << loose_stop_rule(m, p);
   p.dt = float(std::sqrt(1.001e-3 / (9.81 * 1000)));
   EXPECT_EQ(loose_stop_rule(m, p), "");
+  p.dt = 1e-3f;
+  p.max_steps = 1000000;
+  EXPECT_EQ(loose_stop_rule(m, p), "") << "undamped, the fall passes 1 mm a step at step 102";
+  p.damping = 0.2f;  // gamma = 20 /s: at most 9.81 x 1e-3 / 20 = 0.49 mm a step
+  EXPECT_NE(loose_stop_rule(m, p).find("(0.0004905 m at step 1000000)"), std::string::npos) << loose_stop_rule(m, p);
   p.gravity = {};
   p.wind = {};
   EXPECT_EQ(loose_stop_rule(m, p), "") << "no field: nothing to say";
