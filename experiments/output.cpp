@@ -304,19 +304,28 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
   std::vector<std::string> staged;
   for (const auto& e : fs::directory_iterator(staging_))
     staged.push_back(e.path().filename().string() + (e.is_directory() ? "/" : ""));
+  // Until the old manifest is gone nothing has changed: on a failure here the folder is as it
+  // was, and the run's outputs are kept under a name the next run leaves alone.
+  std::string why;
   try {
-    require_replaceable(staged);  // an entry put in the way during the run: nothing is changed yet
+    require_replaceable(staged);  // an entry put in the way during the run
+    fs::remove(dir_ / "manifest.json");
   } catch (const std::invalid_argument& e) {
-    // Not bad input: the run is done, so its outputs stay, under a name the next run leaves alone.
+    why = e.what();
+  } catch (const fs::filesystem_error& e) {
+    why = "cannot remove the manifest of output folder '" + dir_.string() + "' (" + e.code().message() + ")";
+  }
+  if (!why.empty()) {
     const fs::path kept = dir_ / ("unsaved-run-" + std::to_string(::getpid()));
-    fs::rename(staging_, kept);
-    throw std::runtime_error(std::string(e.what()) + "; this run's outputs are in '" + kept.string() + "'");
+    std::error_code ec;
+    fs::rename(staging_, kept, ec);
+    throw std::runtime_error(why + (ec ? "; this run's outputs could not be kept (" + ec.message() + ")"
+                                       : "; this run's outputs are in '" + kept.string() + "'"));
   }
   // From here until the last rename the folder is incomplete. Where a step fails, the staging
   // folder stays for the next run here to finish the commit, as after a process stopped here.
   keep_staging_ = true;
   try {
-    fs::remove(dir_ / "manifest.json");
     for (const auto& name : earlier_)
       if (!fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
     for (const auto& e : fs::directory_iterator(staging_)) {
