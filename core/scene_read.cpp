@@ -6,11 +6,12 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <nlohmann/json.hpp>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <tuple>
 
 #include "json_file.hpp"
 #include "memory.hpp"
@@ -338,12 +339,16 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
       m.pins = PinSet::list;
       m.pin_list.clear();
       const json list = p.is_array() ? p : json::array({p});
-      std::map<json, std::size_t> seen;  // a selector written twice is a slip (differing ones may share nodes)
+      // A selector given twice, as read (1 and 1.0000000001 are one float), is a slip; differing
+      // ones may still share nodes.
+      using Key = std::tuple<int, int, float, float, float, float, float, float>;
+      std::map<Key, std::size_t> seen;
       for (std::size_t k = 0; k < list.size(); ++k) {
         std::string w = where + ".pins";
         if (p.is_array()) w += '[' + std::to_string(k) + ']';
-        m.pin_list.push_back(selector(list[k], w, false));
-        if (const auto [at, added] = seen.emplace(list[k], k); !added)
+        const NodeSelector& s = m.pin_list.emplace_back(selector(list[k], w, false));
+        const Key key{int(s.kind), s.index, s.a.x, s.a.y, s.a.z, s.b.x, s.b.y, s.b.z};
+        if (const auto [at, added] = seen.emplace(key, k); !added)
           bad_value(w, "the same selector as pins[" + std::to_string(at->second) + "]");
       }
     } else {
