@@ -109,9 +109,11 @@ struct Reader {
     std::set_new_handler(nullptr);
     throw std::bad_alloc();
   });
+  const std::string setting = kReadMemoryVariable;
   const std::string cap = "the " + gib(limits.memory) + " of memory " +
-                          (limits.memory_set ? std::string(kReadMemoryVariable) + " allows" : "allowed for a file of its size");
-  const std::string raise = std::string("damaged counts? ") + kReadMemoryVariable + "=N allows N GiB";
+                          (limits.memory_set ? setting + " allows" : "allowed for a file of its size");
+  const std::string raise = limits.memory_set ? setting + "=N allows N GiB"
+                                              : "damaged counts? " + setting + "=N allows N GiB";
   Writer out{fd};
   auto send = [&](const std::string& error) {
     out.bytes(&kError, 1);
@@ -168,11 +170,13 @@ struct ChildEnd {
 ChildLimits child_read_limits(std::int64_t file_bytes) {
   ChildLimits l{std::max<std::int64_t>(std::int64_t(2) << 30, 64 * file_bytes), int(60 + 2 * (file_bytes >> 20))};
   if (const char* set = std::getenv(kReadMemoryVariable)) {
-    char* end = nullptr;
-    const double gib = std::strtod(set, &end);
-    if (end == set || *end != '\0' || !(gib > 0 && gib <= 1048576))
+    const std::string_view text = set;
+    const bool decimal = !text.empty() && text.find_first_not_of("0123456789.") == std::string_view::npos &&
+                         text.find('.') == text.rfind('.') && text.front() != '.' && text.back() != '.';
+    const double gib = decimal ? std::strtod(set, nullptr) : 0.0;
+    if (!(gib >= 0.01 && gib <= 1048576))
       throw std::invalid_argument(std::string(kReadMemoryVariable) + " '" + set +
-                                  "': expected a number of GiB over 0 and at most 1048576");
+                                  "': expected a decimal number of GiB from 0.01 to 1048576");
     l.memory = std::int64_t(gib * double(std::int64_t(1) << 30));
     l.memory_set = true;
   }

@@ -18,14 +18,15 @@ struct ChildLimits {
   bool memory_set = false;  // by kReadMemoryVariable, not by the file's size
 };
 
-// The environment variable that sets the memory cap, in GiB, for files whose mesh takes far more
-// than 64 times their size (a glTF that instances one mesh thousands of times).
+// The environment variable that sets the memory cap in GiB, in place of the one the file's size
+// gives: for files whose mesh takes far more than 64 times their size (a glTF that instances one
+// mesh thousands of times), or a lower cap.
 inline constexpr const char* kReadMemoryVariable = "DEFORMLAB_MESH_READ_GIB";
 
 // The limits for a file of this size: memory 64 times the file, at least 2 GiB (the data
 // segment counts address space, not pages touched: a 34 MB OBJ took 1.2 GB of it in assimp,
 // 560 MB resident), or what kReadMemoryVariable sets (std::invalid_argument where it is no
-// number in (0, 1048576]); CPU 60 s and 2 s a MB (assimp read that OBJ in 1.1 s of CPU time and
+// decimal number in [0.01, 1048576]); CPU 60 s and 2 s a MB (assimp read that OBJ in 1.1 s of CPU time and
 // a 47 MB binary STL in 0.7 s, Gmsh a 52 MB binary .msh in 0.24 s, on a 2-core machine).
 ChildLimits child_read_limits(std::int64_t file_bytes);
 

@@ -104,8 +104,8 @@ TEST(ChildRead, AReaderPastItsMemoryCapIsStopped) {
             "read");
 }
 
-// The cap follows the file's size unless DEFORMLAB_MESH_READ_GIB sets it; a value that is no
-// size is refused, naming the variable.
+// The cap follows the file's size unless DEFORMLAB_MESH_READ_GIB sets it (higher or lower); a
+// value that is no plain decimal size is refused, naming the variable.
 TEST(ChildRead, TheMemoryCapCanBeSetByTheEnvironment) {
   ::unsetenv(kReadMemoryVariable);
   EXPECT_EQ(child_read_limits(1000).memory, std::int64_t(2) << 30);
@@ -121,17 +121,18 @@ TEST(ChildRead, TheMemoryCapCanBeSetByTheEnvironment) {
               m.position.resize(std::size_t(2 * set.memory / sizeof(Vec3f)));
               return m;
             }),
-            "mesh file 'f': reading it took more than the 0.25 GiB of memory DEFORMLAB_MESH_READ_GIB allows (damaged "
-            "counts? DEFORMLAB_MESH_READ_GIB=N allows N GiB)");
+            "mesh file 'f': reading it took more than the 0.25 GiB of memory DEFORMLAB_MESH_READ_GIB allows "
+            "(DEFORMLAB_MESH_READ_GIB=N allows N GiB)");
 #endif
-  for (const char* bad : {"", "abc", "0", "-1", "2x", "inf", "nan", "2000000"}) {
+  for (const char* bad : {"", "abc", "0", "-1", "2x", "inf", "nan", "2000000", " 4", "0x10", "1e3", "1.", ".5",
+                          "1.2.3", "0.001"}) {
     ::setenv(kReadMemoryVariable, bad, 1);
     try {
       child_read_limits(1000);
       ADD_FAILURE() << "accepted '" << bad << "'";
     } catch (const std::invalid_argument& e) {
       EXPECT_EQ(e.what(), "DEFORMLAB_MESH_READ_GIB '" + std::string(bad) +
-                              "': expected a number of GiB over 0 and at most 1048576");
+                              "': expected a decimal number of GiB from 0.01 to 1048576");
     }
   }
   ::unsetenv(kReadMemoryVariable);
