@@ -79,17 +79,18 @@ TEST(CudaTemporal, FastMatchesCudaFusedWithinRounding) {
     for (Integrator integ : kOnePass) {
       const State s0 = perturbed_state(s.sc.m, 5u);
       const int steps = 19;
-      auto cpu = make_cpu_pipeline({s.sc.m, s.sc.p, integ}, Precision::f32, true);
-      auto ref = make_cpu_pipeline({s.sc.m, s.sc.p, integ}, Precision::f64, true);
+      const Params p = for_integrator(s.sc.p, integ);
+      auto cpu = make_cpu_pipeline({s.sc.m, p, integ}, Precision::f32, true);
+      auto ref = make_cpu_pipeline({s.sc.m, p, integ}, Precision::f64, true);
       const State c = advance(*cpu, s0, steps), r = advance(*ref, s0, steps);
-      const RoundingBound b = rounding_bound(c, r, ulp_floor(c, s.sc.p.dt));
+      const RoundingBound b = rounding_bound(c, r, ulp_floor(c, p.dt));
       cuda::Options fo = options(Variant::fused);
       fo.math = Math::fast;
-      auto fused = cuda::make_pipeline({s.sc.m, s.sc.p, integ}, fo);
+      auto fused = cuda::make_pipeline({s.sc.m, p, integ}, fo);
       const State f = advance(*fused, s0, steps);
       for (int k : s.ks) {
         const std::string what = s.name + " " + std::string(info(integ).name) + " k=" + std::to_string(k);
-        auto t = cuda::make_pipeline({s.sc.m, s.sc.p, integ}, temporal(k, s.tile, Math::fast));
+        auto t = cuda::make_pipeline({s.sc.m, p, integ}, temporal(k, s.tile, Math::fast));
         const State g = advance(*t, s0, steps);
         const testing::AssertionResult near = within_rounding(g, f, b);
         EXPECT_TRUE(near) << what;

@@ -63,7 +63,8 @@ TEST(ComputeDispatch, WindowedPassesGiveTheSameBits) {
   for (const Model& m : {small_cloth(37, 53), small_lattice(9, 7, 11)}) {
     const Params p = small_params();
     const State s0 = perturbed_state(m, 11);
-    for (Integrator i : {Integrator::semi_implicit_euler, Integrator::verlet, Integrator::rk4}) {
+    for (Integrator i : {Integrator::explicit_euler, Integrator::semi_implicit_euler, Integrator::verlet,
+                         Integrator::rk4}) {
       auto whole = gl::make_compute_pipeline({m, p, i});
       auto windowed = gl::make_compute_pipeline({m, p, i, {{"window", "400"}}});
       const State a = advance(*whole, s0, 6), b = advance(*windowed, s0, 6);

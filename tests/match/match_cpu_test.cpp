@@ -74,7 +74,8 @@ const std::vector<Integrator> kOnePassAndRk4 = {Integrator::explicit_euler, Inte
                                                 Integrator::verlet, Integrator::rk4};
 const OptionValues kOptionValues[] = {
     {"force", {"tiled", "scatter"}, {0, 3, 7, 8, 9}},
-    {"interop", {"external", "external-gpusync", "staged"}, {0, 3}},
+    // each mode (the default, external-gpusync where the driver has it, else map, runs above)
+    {"interop", {"map", "external", "external-gpusync", "staged"}, {0, 3}},
     {"tile", {"8x4"}, {1, 7, 8}},       // blocks off the grid's sizes; 32-node mesh tiles
     {"link_view", {"2048"}, {7, 8}},  // a mesh's links in 3-4 texture-buffer views
     {"window", {"400"}, {0, 6}, kOnePassAndRk4},  // glsl-compute's passes window by window (grids)

@@ -81,9 +81,13 @@ State perturbed_state(const Model& m, std::uint32_t seed, float pos_amp, float v
   return s;
 }
 
-Params moving_params(const Model& m, Integrator i) {
-  Params p = small_params();
+Params for_integrator(Params p, Integrator i) {
   if (i == Integrator::explicit_euler) p.dt = 1e-4f;
+  return p;
+}
+
+Params moving_params(const Model& m, Integrator i) {
+  Params p = for_integrator(small_params(), i);
   p.wind = {0.002f, 0.f, -0.001f};
   if (m.node_count() > 20) {
     p.drag.node = m.node_count() / 2 + 3;

@@ -29,9 +29,12 @@ Mesh tetrahedralised_box(int nx, int ny, int nz, float jitter = 0.f, std::uint32
 // the caller if wanted, no colliders, no drag.
 Params small_params();
 
+// `p` with dt = 0.1 ms for explicit Euler (at 1 ms it grows ~1.4x per step on these springs,
+// and rounding with it, so that a comparison's tolerance would hide a real fault).
+Params for_integrator(Params p, Integrator i);
+
 // small_params() with wind and, on models of more than 20 nodes, a free node pulled along a
-// path by a drag spring; explicit Euler gets dt = 0.1 ms (at 1 ms it grows ~1.4x per step on
-// these springs). The scene of the tests that compare pipelines.
+// path by a drag spring, for_integrator. The scene of the tests that compare pipelines.
 Params moving_params(const Model& m, Integrator i);
 
 // The rest state moved off rest and set moving: positions jittered by up to `pos_amp`

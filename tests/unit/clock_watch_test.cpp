@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "core/clock_watch.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
@@ -84,6 +85,7 @@ TEST(ClockWatch, SamplesTheGpuWhereTheDriverIsThere) {
   if (!ClockWatch::available()) {
     EXPECT_FALSE(s.watched());
     EXPECT_TRUE(w.samples().empty());
+    EXPECT_FALSE(test::gpu_required()) << "a GPU machine has the NVIDIA driver's NVML";
     return;
   }
   ASSERT_TRUE(s.watched());
