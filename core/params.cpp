@@ -1,5 +1,6 @@
 #include "params.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -24,6 +25,10 @@ namespace {
 bool finite(const Vec3f& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 [[noreturn]] void bad(const std::string& what) { throw std::invalid_argument(what); }
 }  // namespace
+
+double Params::runaway_distance(float extent) const {
+  return double(runaway_factor) * std::max(double(extent), 1e-3);
+}
 
 void validate(const Params& p, int node_count) {
   if (!(p.dt > 0.f) || !std::isfinite(p.dt)) bad("dt must be a positive finite number of seconds");

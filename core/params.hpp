@@ -45,6 +45,12 @@ struct Params {
   int max_steps = 100000;
   int check_every = 1;                  // steps between convergence / divergence checks
   float runaway_factor = 1.f;           // diverged if a node moves > factor * model extent in one step
+
+  // How far a node may move in one step before a run takes it for divergence: runaway_factor x
+  // the model's extent, the extent counted as at least 1 mm.
+  double runaway_distance(float extent) const;
+  // Whether the drag holds node n on its path (hard mode): it follows the path, not its forces.
+  bool hard_dragged(int n) const { return drag.active() && !drag.as_spring && n == drag.node; }
 };
 
 // Throw std::invalid_argument naming the first bad field.

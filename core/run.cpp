@@ -16,10 +16,7 @@ namespace deformlab {
 
 namespace {
 
-// Pinned, or hard-dragged (the node follows its path, not its velocity).
-bool fixed(const Model& m, const Params& p, int n) {
-  return m.inv_mass[n] == 0.f || (p.drag.active() && !p.drag.as_spring && n == p.drag.node);
-}
+bool fixed(const Model& m, const Params& p, int n) { return m.pinned(n) || p.hard_dragged(n); }
 
 // Gershgorin bounds over the free nodes' rows of the linearised model: w2 on the largest squared
 // angular frequency of the springs (and a drag spring), gamma on the largest damping rate (the
@@ -74,11 +71,12 @@ double damping_bound(const Rates& r, Integrator i) {
 }
 
 // Semi-implicit Euler and Verlet on x'' = -w^2 x - gamma x' stay bounded while
-// w^2 dt^2 + 2 gamma dt < 4 (Jury's conditions on the step's matrix), the root in dt here.
+// w^2 dt^2 + 2 gamma dt < 4 (Jury's conditions on the step's matrix), the root in dt here
+// (written 4 / (sqrt(gamma^2 + 4 w^2) + gamma), which does not cancel).
 double together_bound(const Rates& r, Integrator i) {
   if (i != Integrator::semi_implicit_euler && i != Integrator::verlet) return kInfinity;
-  if (r.w2 == 0.0) return r.gamma > 0.0 ? 2.0 / r.gamma : kInfinity;
-  return (std::sqrt(r.gamma * r.gamma + 4.0 * r.w2) - r.gamma) / r.w2;
+  const double root = std::sqrt(r.gamma * r.gamma + 4.0 * r.w2) + r.gamma;
+  return root > 0.0 ? 4.0 / root : kInfinity;
 }
 
 }  // namespace
@@ -102,7 +100,7 @@ std::string step_bound_passed(const Model& m, const Params& p, Integrator i) {
     os << "'s bound for the damping (global damping " << p.damping << " N s/m"
        << (m.damped() ? " and the springs' damping" : "") << ": dt < " << bound(d)
        << " s at the node damped fastest): each step can grow the velocities it damps";
-  else if (const double k = springs_bound(r, i); k > 0.0 && p.dt >= k)
+  else if (const double k = springs_bound(r, i); k > 0.0 && p.dt >= k)  // 0: unstable at any dt, the scheme's notes say
     os << "'s stability bound dt < " << bound(k) << " s on this model's linearised springs";
   else if (const double t = together_bound(r, i); p.dt >= t)
     os << "'s bound for the springs and the damping together (dt < " << bound(t)
@@ -119,12 +117,13 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i) {
   std::ostringstream os;
   if (limit == 0.0) {
     os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable "
-       << "for dt < " << stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
+       << "for dt < " << damped_stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
   } else if (std::isinf(limit)) {
     os << name << " is stable at any dt on the linearised springs: stretching or contact made it diverge";
   } else {
-    os << "dt = " << p.dt << " s is below " << name << "'s bounds on the linearised springs and damping ("
-       << std::min(limit, damped_stability_limit(m, p, i)) << " s): stretching, contact or a stiff drag made it diverge";
+    const double least = std::min({limit, damping_limit(m, p, i), damped_stability_limit(m, p, i)});
+    os << "dt = " << p.dt << " s is below " << name << "'s bounds on the linearised springs and damping (" << least
+       << " s): stretching, contact or a stiff drag made it diverge";
   }
   return os.str();
 }
@@ -190,21 +189,19 @@ double free_fall_step(const Model& m, const Params& p, int step) {
   for (int n = 0; n < m.node_count(); ++n) {
     if (fixed(m, p, n)) continue;
     const double a = norm(Vec3d(p.gravity) + Vec3d(p.wind) * double(m.inv_mass[n]));
-    const double q = 1.0 - double(p.damping) * m.inv_mass[n] * dt;
-    if (q <= -1.0) return 0.0;
-    far = std::max(far, a * dt * dt * (q == 1.0 ? k : (1.0 - std::pow(q, k)) / (1.0 - q)));
+    const double gdt = double(p.damping) * m.inv_mass[n] * dt;  // 1 - q
+    if (gdt >= 2.0) return 0.0;
+    const double sum = gdt == 0.0 ? k : gdt < 1.0 ? -std::expm1(k * std::log1p(-gdt)) / gdt
+                                                  : (1.0 - std::pow(1.0 - gdt, k)) / gdt;
+    far = std::max(far, a * dt * dt * sum);
   }
   return far;
-}
-
-double runaway_distance(const Params& p, float extent) {
-  return double(p.runaway_factor) * std::max(double(extent), 1e-3);
 }
 
 }  // namespace
 
 std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t) {
-  const double runaway = runaway_distance(p, extent);
+  const double runaway = p.runaway_distance(extent);
   if (std::isfinite(disp) && disp <= runaway) return {};
   std::ostringstream os;
   os << "diverged at step " << step << " (t = " << t << " s): ";
@@ -213,13 +210,16 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
   else
     os << "a node moved " << disp << " m in one step, more than " << runaway
        << " m (runaway_factor x model extent, the extent counted as at least 1 mm)";
+  // A fall alone makes a state non-finite only where a step's move overflows float's |d|^2.
   const double fall = free_fall_step(m, p, step);
-  if (fall <= runaway) {
+  const double beyond = std::isfinite(disp) ? runaway : std::sqrt(double(std::numeric_limits<float>::max()));
+  if (fall <= beyond) {
     os << "; " << stability_hint(m, p, i);
     return os.str();
   }
-  os << "; gravity and wind alone move a free node falling from rest " << fall << " m at this step, more than the "
-     << "runaway distance " << runaway << " m: the field stopped the run";
+  os << "; gravity and wind alone move a free node falling from rest " << fall << " m at this step, more than "
+     << (std::isfinite(disp) ? "the runaway distance " : "float holds for a move, ") << beyond
+     << " m: the field stopped the run";
   if (std::isfinite(disp)) os << " (a larger runaway_factor admits the fall)";
   if (const std::string passed = step_bound_passed(m, p, i); !passed.empty()) os << "; also, " << passed;
   return os.str();
@@ -227,14 +227,21 @@ std::string divergence(double disp, float extent, const Model& m, const Params& 
 
 std::string loose_stop_rule(const Model& m, const Params& p) {
   std::ostringstream os;
-  if (const double runaway = runaway_distance(p, m.extent()); p.threshold >= runaway)
+  if (const double runaway = p.runaway_distance(m.extent()); p.threshold >= runaway)
     os << "threshold = " << p.threshold << " m a step is at least the runaway distance " << runaway
        << " m: every step that does not diverge passes the stop rule";
-  else if (const double fall = free_fall_step(m, p, p.max_steps); fall > 0.0 && p.threshold > fall)
-    os << "threshold = " << p.threshold << " m a step (" << p.threshold / p.dt << " m/s at dt = " << p.dt
-       << " s) is more than gravity and wind alone move a node falling from rest at any step up to max_steps ("
-       << fall << " m at step " << p.max_steps << "): unless springs or the drag move nodes faster, the stop rule "
-       << "holds at its first check";
+  else if (const int first = first_stop_step(p); first <= p.max_steps) {
+    // The fall's step grows to max_steps, or, where the damping overshoots (q < 0), swings
+    // about its terminal step, widest at the first step of the range or the one after.
+    double fall = 0.0;
+    for (const int k : {first, std::min(first + 1, p.max_steps), p.max_steps})
+      fall = std::max(fall, free_fall_step(m, p, k));
+    if (fall > 0.0 && p.threshold > fall)
+      os << "threshold = " << p.threshold << " m a step (" << p.threshold / p.dt << " m/s at dt = " << p.dt
+         << " s) is more than gravity and wind alone move a node falling from rest in any step from the stop "
+         << "rule's first check to max_steps (" << fall << " m at most): unless springs or the drag move nodes "
+         << "faster, the rule holds at its first check";
+  }
   return os.str();
 }
 

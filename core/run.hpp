@@ -32,8 +32,9 @@ double stability_limit(const Model& m, const Params& p, Integrator i);
 // for backward Euler.
 double damping_limit(const Model& m, const Params& p, Integrator i);
 // Semi-implicit Euler's and Verlet's bound with the springs and the damping together, where
-// w_max^2 dt^2 + 2 gamma_max dt = 4: under both of the above, and under each alone where the
-// other is 0. Infinite for the other schemes.
+// w_max^2 dt^2 + 2 gamma_max dt = 4: under both of the above, and equal to one where the other
+// rate is 0. Infinite for the other schemes, for which none is derived here (RK4's region has
+// points under both of its bounds where a mode grows: w dt near 2.7 with gamma dt near 2.5).
 double damped_stability_limit(const Model& m, const Params& p, Integrator i);
 // Empty, or "dt = ... s is above <i>'s bound ..." naming the first of the three bounds that dt
 // reaches (the damping's, the springs', both together) and its value.
@@ -49,8 +50,8 @@ std::string stability_hint(const Model& m, const Params& p, Integrator i);
 std::string divergence(double disp, float extent, const Model& m, const Params& p, Integrator i, int step, double t);
 
 // Empty, or why the stop rule passes whatever a run does: a threshold at or over the runaway
-// distance, or one that gravity and wind do not reach in max_steps of a fall from rest (a dt
-// too small for the threshold).
+// distance, or one that gravity and wind do not reach in any step of a fall from rest between
+// the rule's first check and max_steps (a dt too small for the threshold).
 std::string loose_stop_rule(const Model& m, const Params& p);
 
 class DivergenceError : public std::runtime_error {

@@ -38,9 +38,9 @@ json to_json(const NodeSelector& s) {
 // A free node that starts deeper in the ground or a sphere than a step may move it (runaway_factor
 // x extent) is pushed out by more at the first step, which a run takes for divergence: refused.
 void require_start_outside_colliders(const Model& m, const Params& p) {
-  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3);
+  const double bound = p.runaway_distance(m.extent());
   for (int i = 0; i < m.node_count(); ++i) {
-    if (m.pinned(i) || (p.drag.active() && !p.drag.as_spring && i == p.drag.node)) continue;
+    if (m.pinned(i) || p.hard_dragged(i)) continue;
     const Vec3f x = m.rest_position[i];
     std::string where;
     double depth = 0;
@@ -62,7 +62,7 @@ void require_start_outside_colliders(const Model& m, const Params& p) {
 // the scene's path).
 void require_drag_steps_in_bound(const Model& m, const Params& p, bool inserted, const std::string& where) {
   if (!p.drag.active() || p.drag.as_spring) return;
-  const double bound = double(p.runaway_factor) * std::max(double(m.extent()), 1e-3), dt = p.dt;
+  const double bound = p.runaway_distance(m.extent()), dt = p.dt;
   const auto& path = p.drag.path;
   std::vector<double> starts = {0.0};
   for (const Keyframe& k : path) starts.insert(starts.end(), {double(k.t), double(k.t) - dt});

@@ -209,9 +209,16 @@ TEST(Run, AFieldTooStrongForTheRunawayCheckIsNamed) {
   }
   const Integrator semi = Integrator::semi_implicit_euler;
   const double runaway = double(p.runaway_factor) * m.extent();  // 0.35 m
-  // Not finite: the field named, without runaway_factor's help.
+  // Not finite: the field is named only where its fall overflows a move's float length (a fall
+  // of 4 km would have tripped the distance check first).
+  const std::string finite_fall = divergence(INFINITY, m.extent(), m, p, semi, 1, 0.0);
+  EXPECT_EQ(finite_fall.find("gravity and wind"), std::string::npos) << finite_fall;
+  p.gravity = {0.f, -1e30f, 0.f};  // 4e24 m in the first step
   const std::string overflow = divergence(INFINITY, m.extent(), m, p, semi, 1, 0.0);
-  EXPECT_NE(overflow.find("not finite in float; gravity and wind alone"), std::string::npos) << overflow;
+  EXPECT_NE(overflow.find("not finite in float; gravity and wind alone move a free node falling from rest 4e+24 m at "
+                          "this step, more than float holds for a move, 1.84467e+19 m: the field stopped the run"),
+            std::string::npos)
+      << overflow;
   EXPECT_EQ(overflow.find("runaway_factor admits"), std::string::npos) << overflow;
   // g = 1e3 at dt = 2 ms: step 1000 of an undamped fall moves 4 m; damped at gamma = 100 /s,
   // 2 cm (a dt / gamma): under the runaway distance, so the stability bound is named.
@@ -240,14 +247,24 @@ TEST(Run, AStopRuleThatAnyRunPassesIsNamed) {
   p.max_steps = 1000;
   p.damping = 0.f;
   p.dt = float(std::sqrt(0.999e-3 / (9.81 * 1000)));  // the 1000th step of a fall moves 0.999 mm
-  EXPECT_NE(loose_stop_rule(m, p).find("at step 1000): unless springs"), std::string::npos) << loose_stop_rule(m, p);
+  EXPECT_NE(loose_stop_rule(m, p).find("(0.000999 m at most): unless springs"), std::string::npos)
+      << loose_stop_rule(m, p);
   p.dt = float(std::sqrt(1.001e-3 / (9.81 * 1000)));
   EXPECT_EQ(loose_stop_rule(m, p), "");
   p.dt = 1e-3f;
   p.max_steps = 1000000;
   EXPECT_EQ(loose_stop_rule(m, p), "") << "undamped, the fall passes 1 mm a step at step 102";
   p.damping = 0.2f;  // gamma = 20 /s: at most 9.81 x 1e-3 / 20 = 0.49 mm a step
-  EXPECT_NE(loose_stop_rule(m, p).find("(0.0004905 m at step 1000000)"), std::string::npos) << loose_stop_rule(m, p);
+  EXPECT_NE(loose_stop_rule(m, p).find("(0.0004905 m at most)"), std::string::npos) << loose_stop_rule(m, p);
+  // gamma dt = 1.5: the speed overshoots its terminal value, so the first step moves most
+  // (a dt^2 = 2.21 mm, the terminal step 1.47 mm).
+  p.dt = 0.015f;
+  p.damping = 1.f;
+  p.min_steps = 1;
+  p.threshold = 2e-3f;
+  EXPECT_EQ(loose_stop_rule(m, p), "") << "the first steps pass 2 mm";
+  p.threshold = 2.3e-3f;
+  EXPECT_NE(loose_stop_rule(m, p).find("(0.00220725 m at most)"), std::string::npos) << loose_stop_rule(m, p);
   p.gravity = {};
   p.wind = {};
   EXPECT_EQ(loose_stop_rule(m, p), "") << "no field: nothing to say";
