@@ -220,8 +220,27 @@ TEST_F(Cli, MeshNotesWhatARunOfTheSceneWouldRefuse) {
   const Result made = run("mesh --scene " + (dir_ / "s.json").string() + " --out " + file.string());
   ASSERT_EQ(made.code, 0) << made.err;
   EXPECT_TRUE(fs::is_regular_file(file));
-  EXPECT_EQ(made.err, "deformlab: note: a run of this scene on the mesh would refuse it: " + (dir_ / "s.json").string() +
-                          ".model.pins[0]: the box holds no node of the model\n");
+  EXPECT_EQ(made.err, "deformlab: note: a run of this scene on the mesh would refuse it: " +
+                          (dir_ / "s.json").string() + ".model.pins[0]: the box holds no node of the model\n");
+}
+
+// The check places the written mesh as a run naming it would: a generated mesh still takes the
+// scene's transform, a filled one is not placed twice. Box pins around where each lies pick
+// nodes only so (a missed placement would leave them empty, and a note).
+TEST_F(Cli, MeshChecksThePinsOnTheMeshAsARunPlacesIt) {
+  write("generated.json", R"({"model": {"type": "mesh", "transform": {"translate": [0, 5, 0]},
+      "generate": {"shape": "sheet", "size": [0.2, 0.1], "cell_size": 0.05},
+      "pins": [{"box": [[-1, 4.9, -1], [1, 5.1, 1]]}]}})");
+  // The bunny's lowest vertex: y = -0.003149 in the file, 0.29994 m placed (0.30600 placed twice).
+  write("filled.json", R"({"model": {"type": "mesh", "file": ")" DEFORMLAB_SOURCE_DIR R"(/data/bunny/bunny.obj",
+      "scale": 0.02, "transform": {"translate": [0.03, 0.3, 0]}, "fill": "tetrahedra",
+      "pins": [{"box": [[-1, 0.29, -1], [1, 0.303, 1]]}]}})");
+  for (const char* scene : {"generated", "filled"}) {
+    const Result made = run("mesh --scene " + (dir_ / (std::string(scene) + ".json")).string() + " --out " +
+                            (dir_ / (std::string(scene) + ".msh")).string());
+    ASSERT_EQ(made.code, 0) << scene << ": " << made.err;
+    EXPECT_EQ(made.err, "") << scene;
+  }
 }
 
 // A filled surface (the bunny-soft scene's) written out: a scene naming the file without "fill",
@@ -333,7 +352,8 @@ TEST_F(Cli, NotesADtOverTheStabilityBound) {
                           "together (dt < 0.00181 s,"),
             std::string::npos)
       << both.err;
-  const Result under = run("run --pipeline cpu --lattice 8x8x8 --dt 0.0018 --steps 5 --out " + (dir_ / "under").string());
+  const Result under =
+      run("run --pipeline cpu --lattice 8x8x8 --dt 0.0018 --steps 5 --out " + (dir_ / "under").string());
   ASSERT_EQ(under.code, 0) << under.err;
   EXPECT_EQ(under.err.find("note: dt"), std::string::npos) << under.err;
 }
