@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "grid_stencil.hpp"
@@ -111,6 +112,8 @@ struct NodeSelector {
   std::string where;  // the scene key it was read from, for errors (empty: made in code)
   static NodeSelector node(int v) { return {Kind::index, v}; }
   bool single() const { return kind == Kind::index || kind == Kind::nearest || kind == Kind::center; }
+  // What it selects by, without `where`: equal for two selectors that pick the same nodes alike.
+  auto key() const { return std::tuple(kind, index, a.x, a.y, a.z, b.x, b.y, b.z); }
 };
 // The model's nodes a selector picks, in ascending order (model numbering); throws
 // std::invalid_argument when an index is outside the model or a selector picks nothing (its

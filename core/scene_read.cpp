@@ -11,7 +11,6 @@
 #include <set>
 #include <span>
 #include <stdexcept>
-#include <tuple>
 
 #include "json_file.hpp"
 #include "memory.hpp"
@@ -341,14 +340,12 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
       const json list = p.is_array() ? p : json::array({p});
       // A selector given twice, as read (1 and 1.0000000001 are one float), is a slip; differing
       // ones may still share nodes.
-      using Key = std::tuple<int, int, float, float, float, float, float, float>;
-      std::map<Key, std::size_t> seen;
+      std::map<decltype(NodeSelector{}.key()), std::size_t> seen;
       for (std::size_t k = 0; k < list.size(); ++k) {
         std::string w = where + ".pins";
         if (p.is_array()) w += '[' + std::to_string(k) + ']';
         const NodeSelector& s = m.pin_list.emplace_back(selector(list[k], w, false));
-        const Key key{int(s.kind), s.index, s.a.x, s.a.y, s.a.z, s.b.x, s.b.y, s.b.z};
-        if (const auto [at, added] = seen.emplace(key, k); !added)
+        if (const auto [at, added] = seen.emplace(s.key(), k); !added)
           bad_value(w, "the same selector as pins[" + std::to_string(at->second) + "]");
       }
     } else {
