@@ -319,8 +319,8 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
     const fs::path kept = dir_ / ("unsaved-run-" + std::to_string(::getpid()));
     std::error_code ec;
     fs::rename(staging_, kept, ec);
-    throw std::runtime_error(why + (ec ? "; this run's outputs could not be kept (" + ec.message() + ")"
-                                       : "; this run's outputs are in '" + kept.string() + "'"));
+    keep_staging_ = bool(ec);  // where they could not be moved aside, they stay where they are
+    throw std::runtime_error(why + "; this run's outputs are in '" + (ec ? staging_ : kept).string() + "'");
   }
   // From here until the last rename the folder is incomplete. Where a step fails, the staging
   // folder stays for the next run here to finish the commit, as after a process stopped here.
