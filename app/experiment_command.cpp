@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -9,13 +10,24 @@
 #include "experiments/ceilings.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/output.hpp"
+#include "experiments/pipelines.hpp"
 #include "experiments/report.hpp"
 #include "experiments/sweep.hpp"
 #include "experiments/sweep_folder.hpp"
 #include "experiments/sweep_models.hpp"
 
 namespace deformlab::app {
+namespace {
 
+// Whether a pipeline of the sweep runs on the GPU: a calibration's ceilings are the GPU's.
+bool sweeps_a_gpu(const Sweep& s) {
+  return std::any_of(s.pipelines.begin(), s.pipelines.end(), [](const std::string& name) {
+    const PipelineEntry* e = pipelines().find(name);
+    return e && on_gpu(*e);
+  });
+}
+
+}  // namespace
 
 int experiment_command(const ExperimentArgs& a) {
   Experiment x;
@@ -68,8 +80,10 @@ int experiment_command(const ExperimentArgs& a) {
       write_atomically(dir / "manifest.json", manifest.dump(2) + "\n");
     }
     if (!a.report_only) {
+      const InterruptCatcher signals;  // while calibrating, and between cells: the cells done stay
       const nlohmann::json earlier = read_manifest(dir);
-      if (calibration.is_null() && !(earlier.is_object() && earlier.value("calibration", nlohmann::json()).is_object())) {
+      if (calibration.is_null() && sweeps_a_gpu(*sweep) &&
+          !(earlier.is_object() && earlier.value("calibration", nlohmann::json()).is_object())) {
         // Measured once per results folder, where this machine can (CUDA and GL together).
         try {
           std::cout << "calibrating this device (`deformlab calibrate`)" << std::endl;
@@ -77,6 +91,8 @@ int experiment_command(const ExperimentArgs& a) {
         } catch (const std::invalid_argument& e) {
           std::cout << "no calibration: " << e.what() << "\n";
         }
+        if (const int sig = InterruptCatcher::caught())
+          throw Interrupted(sig, signal_name(sig) + " while calibrating: the experiment stopped before its cells");
       }
       std::cout << "deformlab experiment " << x.name << ": " << cells(*sweep).size() << " cells into "
                 << dir.string() << " (cells already there are kept, but for those of another scene or method)\n";
@@ -101,7 +117,6 @@ int experiment_command(const ExperimentArgs& a) {
         std::cout << "]" << std::endl;
       };
       nlohmann::json command = a.argv;
-      const InterruptCatcher signals;  // between cells: the cells done stay
       const int ran = run_sweep(x, *sweep, dir, o, command);
       std::cout << "ran " << ran << " cells, kept " << int(cells(*sweep).size()) - ran << "\n";
     }
