@@ -117,7 +117,7 @@ Experiment load_experiment_by_name(const std::string& path_or_name, const std::s
   const std::string file = name.is_relative() && !from.empty() ? (std::filesystem::path(from) / name).string() : path_or_name;
   if (path_or_name.find_first_of("/.") == std::string::npos) {
     if (const auto text = experiment_files::find(path_or_name + ".json"))
-      return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_data_dir());
+      return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_experiments_dir());
     std::error_code ec;
     if (!std::filesystem::exists(file, ec))
       throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name +
@@ -136,16 +136,17 @@ std::string builtin_experiment_names(bool sweeps_only) {
   return names;
 }
 
-std::string builtin_data_dir() {
+std::string builtin_experiments_dir() {
   namespace fs = std::filesystem;
   std::error_code ec;
   for (fs::path p = fs::read_symlink("/proc/self/exe", ec); !ec && p.has_relative_path(); p = p.parent_path())
-    if (fs::is_directory(p / "data", ec) && fs::is_directory(p / "experiments", ec)) return (p / "data").string();
-  return DEFORMLAB_SOURCE_DIR "/data";
+    if (fs::is_directory(p / "data", ec) && fs::is_directory(p / "experiments", ec))
+      return (p / "experiments").string();
+  return DEFORMLAB_SOURCE_DIR "/experiments";
 }
 
 Experiment default_experiment() {
-  return parse_experiment(std::string(experiment_files::paper_drag_json), "built-in paper-drag.json", builtin_data_dir());
+  return parse_experiment(std::string(experiment_files::paper_drag_json), "built-in paper-drag.json", builtin_experiments_dir());
 }
 
 }  // namespace deformlab

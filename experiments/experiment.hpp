@@ -31,7 +31,8 @@ constexpr const char* kPlainName = "expected a name of up to 64 letters, digits,
 Experiment parse_experiment(const std::string& text, const std::string& where, const std::string& dir = "");
 Experiment load_experiment(const std::string& path);
 // A path to an experiment file, or the name of one built into the binary ("table1"). A
-// built-in experiment's mesh files are taken from the source tree's data/ (builtin_data_dir).
+// built-in experiment's mesh files are taken from the source tree's experiments/
+// (builtin_experiments_dir), as they are when its file there is named by its path.
 // A file without a "name" is named by its file name without ".json", where that is a plain name.
 // A name that is neither is bad input naming the built-in ones. A relative file is taken from
 // folder `from` (an experiment file's, for its "base") where it is given.
@@ -39,10 +40,10 @@ Experiment load_experiment_by_name(const std::string& path_or_name, const std::s
 // The names of the experiments built into the binary (experiments/*.json), comma-separated:
 // "gl-memory, interop, ..."; with `sweeps_only`, those with a sweep (`deformlab experiment`'s).
 std::string builtin_experiment_names(bool sweeps_only = false);
-// The data/ folder of the source tree this binary was built in: the first folder above the
-// running executable that holds data/ and experiments/ (a build inside a tree, wherever the
+// The experiments/ folder of the source tree this binary was built in: the first folder above
+// the running executable that holds data/ and experiments/ (a build inside a tree, wherever the
 // tree was moved), else the source tree it was configured from.
-std::string builtin_data_dir();
+std::string builtin_experiments_dir();
 // The built-in experiment that `deformlab run` runs with no arguments (experiments/paper-drag.json).
 Experiment default_experiment();
 

@@ -264,9 +264,9 @@ TEST_F(SweepTest, ModelsByOrders) {
   const Experiment x = parse_experiment(R"({"name": "meshes-tiny", "base": "meshes", "sweep": {
       "models": [{"name": "sheet", "model": {"generate": {"shape": "sheet", "size": [0.2, 0.2], "cell_size": 0.02},
                                              "scale": 1, "transform": {"translate": [0, 0.3, 0]}}},
-                 {"name": "bunny-shell", "model": {"file": "bunny/bunny.obj", "fill": "none"}}],
+                 {"name": "bunny-shell", "model": {"file": "../data/bunny/bunny.obj", "fill": "none"}}],
       "orders": ["file", "shuffled", "rcm"], "pipelines": ["cpu", "omp"],
-      "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})", "tiny.json", builtin_data_dir());
+      "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})", "tiny.json", builtin_experiments_dir());
   const Sweep s = *parse_sweep(x.raw, "tiny");
   const auto all = cells(s);
   ASSERT_EQ(all.size(), 12u);
@@ -349,18 +349,26 @@ TEST_F(SweepTest, LatticeSweepsCountAndLabelTheirSizesCubed) {
   EXPECT_FALSE(parse_sweep(tiny(R"({"sizes": [1025], "pipelines": ["cpu"]})").raw, "tiny")->lattice);
 }
 
-// The built-in experiments are the source tree's experiments/*.json, each loading by its name,
-// and the names the CLI's help and its bad-input line give are theirs.
+// The built-in experiments are the source tree's experiments/*.json, each loading by its name
+// as its file does by its path, and the names the CLI's help and its bad-input line give are
+// theirs.
 TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
   std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(fs::path(builtin_data_dir()).parent_path() / "experiments"))
+  for (const auto& e : fs::directory_iterator(builtin_experiments_dir()))
     if (e.path().extension() == ".json") files.insert(e.path().stem().string());
   ASSERT_GE(files.size(), 11u);
   std::set<std::string> named;
   std::stringstream list(builtin_experiment_names());
   for (std::string n; std::getline(list >> std::ws, n, ',');) named.insert(n);
   EXPECT_EQ(named, files);
-  for (const std::string& n : files) EXPECT_EQ(load_experiment_by_name(n).name, n);
+  for (const std::string& n : files) {
+    const Experiment by_name = load_experiment_by_name(n);
+    EXPECT_EQ(by_name.name, n);
+    // Named by its path, the file reads the same scene, its mesh files from the same places.
+    const Experiment by_path = load_experiment((fs::path(builtin_experiments_dir()) / (n + ".json")).string());
+    EXPECT_EQ(to_json(by_path.scene), to_json(by_name.scene)) << n;
+    if (const std::string& f = by_path.scene.model.mesh.file; !f.empty()) EXPECT_TRUE(fs::exists(f)) << n << ": " << f;
+  }
   // `deformlab experiment`'s help names those with a sweep.
   std::set<std::string> swept;
   std::stringstream sweeps(builtin_experiment_names(true));
