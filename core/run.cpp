@@ -79,16 +79,8 @@ double together_bound(const Rates& r, Integrator i) {
   return root > 0.0 ? 4.0 / root : kInfinity;
 }
 
-}  // namespace
-
-double stability_limit(const Model& m, const Params& p, Integrator i) { return springs_bound(rates(m, p), i); }
-double damping_limit(const Model& m, const Params& p, Integrator i) { return damping_bound(rates(m, p), i); }
-double damped_stability_limit(const Model& m, const Params& p, Integrator i) {
-  return together_bound(rates(m, p), i);
-}
-
-std::string step_bound_passed(const Model& m, const Params& p, Integrator i) {
-  const Rates r = rates(m, p);
+// "dt = ... s is above <i>'s bound ..." for the first bound of `r` that dt reaches, or "".
+std::string bound_passed(const Rates& r, const Model& m, const Params& p, Integrator i) {
   const auto bound = [](double v) {
     std::ostringstream os;
     os << std::setprecision(3) << v;
@@ -110,18 +102,31 @@ std::string step_bound_passed(const Model& m, const Params& p, Integrator i) {
   return os.str();
 }
 
+}  // namespace
+
+double stability_limit(const Model& m, const Params& p, Integrator i) { return springs_bound(rates(m, p), i); }
+double damping_limit(const Model& m, const Params& p, Integrator i) { return damping_bound(rates(m, p), i); }
+double damped_stability_limit(const Model& m, const Params& p, Integrator i) {
+  return together_bound(rates(m, p), i);
+}
+
+std::string step_bound_passed(const Model& m, const Params& p, Integrator i) {
+  return bound_passed(rates(m, p), m, p, i);
+}
+
 std::string stability_hint(const Model& m, const Params& p, Integrator i) {
-  if (std::string passed = step_bound_passed(m, p, i); !passed.empty()) return passed;
-  const double limit = stability_limit(m, p, i);
+  const Rates r = rates(m, p);
+  if (std::string passed = bound_passed(r, m, p, i); !passed.empty()) return passed;
+  const double limit = springs_bound(r, i);
   const std::string name(info(i).name);
   std::ostringstream os;
   if (limit == 0.0) {
     os << name << " amplifies undamped spring oscillations at any dt (semi-implicit-euler and verlet are stable "
-       << "for dt < " << damped_stability_limit(m, p, Integrator::semi_implicit_euler) << " s on this model)";
+       << "for dt < " << together_bound(r, Integrator::semi_implicit_euler) << " s on this model)";
   } else if (std::isinf(limit)) {
     os << name << " is stable at any dt on the linearised springs: stretching or contact made it diverge";
   } else {
-    const double least = std::min({limit, damping_limit(m, p, i), damped_stability_limit(m, p, i)});
+    const double least = std::min({limit, damping_bound(r, i), together_bound(r, i)});
     os << "dt = " << p.dt << " s is below " << name << "'s bounds on the linearised springs and damping (" << least
        << " s): stretching, contact or a stiff drag made it diverge";
   }
@@ -172,10 +177,6 @@ class StepTimes {
   std::size_t filled_ = 0;
   std::vector<double> start_ms_;  // host clock at each pending step's start
 };
-
-}  // namespace
-
-namespace {
 
 // How far gravity and wind alone move a free node in step `step` of a fall from rest, the
 // farthest over the free nodes: semi-implicit Euler's v_k = (1 - gamma dt) v_(k-1) + a dt moves

@@ -112,8 +112,7 @@ struct Reader {
   const std::string setting = kReadMemoryVariable;
   const std::string cap = "the " + gib(limits.memory) + " of memory " +
                           (limits.memory_set ? setting + " allows" : "allowed for a file of its size");
-  const std::string raise = limits.memory_set ? setting + "=N allows N GiB"
-                                              : "damaged counts? " + setting + "=N allows N GiB";
+  const std::string raise = (limits.memory_set ? "" : "damaged counts? ") + setting + "=N allows N GiB";
   Writer out{fd};
   auto send = [&](const std::string& error) {
     out.bytes(&kError, 1);

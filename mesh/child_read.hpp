@@ -26,8 +26,9 @@ inline constexpr const char* kReadMemoryVariable = "DEFORMLAB_MESH_READ_GIB";
 // The limits for a file of this size: memory 64 times the file, at least 2 GiB (the data
 // segment counts address space, not pages touched: a 34 MB OBJ took 1.2 GB of it in assimp,
 // 560 MB resident), or what kReadMemoryVariable sets (std::invalid_argument where it is no
-// decimal number in [0.01, 1048576]); CPU 60 s and 2 s a MB (assimp read that OBJ in 1.1 s of CPU time and
-// a 47 MB binary STL in 0.7 s, Gmsh a 52 MB binary .msh in 0.24 s, on a 2-core machine).
+// decimal number in [0.01, 1048576]); CPU 60 s and 2 s a MB (assimp read that OBJ in 1.1 s of
+// CPU time and a 47 MB binary STL in 0.7 s, Gmsh a 52 MB binary .msh in 0.24 s, on a 2-core
+// machine).
 ChildLimits child_read_limits(std::int64_t file_bytes);
 
 // Runs read(notes) in a child process under `limits` and returns its mesh and notes. Throws
