@@ -304,20 +304,39 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
   std::vector<std::string> staged;
   for (const auto& e : fs::directory_iterator(staging_))
     staged.push_back(e.path().filename().string() + (e.is_directory() ? "/" : ""));
-  // Until the old manifest is gone nothing has changed: on a failure here the folder is as it
-  // was, and the run's outputs are kept under a name the next run leaves alone.
+  // Until the old manifest is gone the folder holds the earlier run: on a failure here it is put
+  // back as it was, and this run's outputs are kept under a name the next run leaves alone. The
+  // earlier run's outputs that this one does not write go aside first, into a temporary folder
+  // that this commit or the next run here removes, so that a commit stopped after the old
+  // manifest is gone leaves none of them in the folder, unlisted, for the next run to refuse.
+  const fs::path aside = temporary(dir_ / "stale");
+  std::vector<fs::path> moved_aside;
   std::string why;
   try {
     require_replaceable(staged);  // an entry put in the way during the run
+    for (const auto& name : earlier_) {
+      const fs::path entry = entry_name(name);
+      std::error_code ec;
+      if (fs::exists(staging_ / entry) || !fs::exists(fs::symlink_status(dir_ / entry, ec))) continue;
+      fs::create_directory(aside);
+      fs::rename(dir_ / entry, aside / entry);
+      moved_aside.push_back(entry);
+      if (moved) moved(aside / entry);
+    }
     fs::remove(dir_ / "manifest.json");
   } catch (const std::invalid_argument& e) {
     why = e.what();
   } catch (const fs::filesystem_error& e) {
-    why = "cannot remove the manifest of output folder '" + dir_.string() + "' (" + e.code().message() + ")";
+    why = e.path1().filename() == "manifest.json"
+              ? "cannot remove the manifest of output folder '" + dir_.string() + "' (" + e.code().message() + ")"
+              : "cannot move the earlier run's '" + e.path1().filename().string() + "' out of output folder '" +
+                    dir_.string() + "' (" + e.code().message() + ")";
   }
   if (!why.empty()) {
-    const fs::path kept = dir_ / ("unsaved-run-" + std::to_string(::getpid()));
     std::error_code ec;
+    for (const fs::path& entry : moved_aside) fs::rename(aside / entry, dir_ / entry, ec);
+    fs::remove(aside, ec);
+    const fs::path kept = dir_ / ("unsaved-run-" + std::to_string(::getpid()));
     fs::rename(staging_, kept, ec);
     keep_staging_ = bool(ec);  // where they could not be moved aside, they stay where they are
     throw std::runtime_error(why + "; this run's outputs are in '" + (ec ? staging_ : kept).string() + "'");
@@ -326,8 +345,6 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
   // folder stays for the next run here to finish the commit, as after a process stopped here.
   keep_staging_ = true;
   try {
-    for (const auto& name : earlier_)
-      if (!fs::exists(staging_ / entry_name(name))) fs::remove_all(dir_ / entry_name(name));
     for (const auto& e : fs::directory_iterator(staging_)) {
       if (e.path().filename() == "manifest.json") continue;
       const fs::path target = dir_ / e.path().filename();
@@ -336,6 +353,8 @@ void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {
       if (moved) moved(target);
     }
     if (fs::exists(staging_ / "manifest.json")) fs::rename(staging_ / "manifest.json", dir_ / "manifest.json");
+    std::error_code ec;
+    fs::remove_all(aside, ec);
   } catch (const fs::filesystem_error& e) {
     throw std::runtime_error("cannot finish moving this run's outputs into '" + dir_.string() + "' (" +
                              e.code().message() + "): the rest are in '" + staging_.string() +

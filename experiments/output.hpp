@@ -85,14 +85,15 @@ class OutputDir {
   // Where to write a file or folder named `name` before commit().
   std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
   // Moves every staged entry into the output folder (replacing entries of the same name):
-  // the old manifest.json is removed first, then the old output's files the new one lacks, and
-  // the new manifest is moved in last. Where an entry of the other kind (file or folder) has
-  // appeared in the way since, or the old manifest cannot be removed, throws std::runtime_error
+  // the old output's files the new one lacks are moved aside first (into a temporary folder,
+  // removed at the end), then the old manifest.json is removed, and the new manifest is moved in
+  // last. Where an entry of the other kind (file or folder) has appeared in the way since, or
+  // the old files cannot be moved aside or the old manifest removed, throws std::runtime_error
   // with the folder as it was and the outputs moved to `dir`/unsaved-run-<pid>. Where a removal
   // or rename fails after that, throws std::runtime_error and keeps the staging folder, which
   // the next OutputDir of `dir` moves in.
-  // `moved`, where given, is called after each entry but the manifest is moved into place, with
-  // its new path (a test stops a commit there).
+  // `moved`, where given, is called after each entry but the manifest is moved aside or into
+  // place, with its new path (a test stops a commit there).
   void commit(const std::function<void(const std::filesystem::path&)>& moved = {});
   const std::filesystem::path& dir() const { return dir_; }
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -168,6 +169,45 @@ TEST(OutputDir, CommitRemovesTheOldOutputsTheNewOneLacks) {
   for (const char* f : {"state.ply", "trace.json", "frames"}) EXPECT_FALSE(fs::exists(dir / f)) << f;
   EXPECT_EQ(read(dir / "notes.txt"), "old") << "not an output: kept";
   fs::remove_all(dir);
+}
+
+// A commit stopped after any of its moves (the old outputs the new run lacks aside, then the new
+// outputs in) leaves a folder that the next run accepts, whatever it writes: none of the old
+// outputs is left there unlisted, and the next commit leaves nothing else behind.
+TEST(OutputDir, ACommitStoppedAnywhereLeavesNoOldOutputUnlisted) {
+  const std::vector<std::string> all = {"summary.txt", "state.ply", "trace.json", "frames/"};
+  for (int stop = 1; stop <= 4; ++stop) {  // 3 entries aside, 1 in
+    SCOPED_TRACE("stopped after move " + std::to_string(stop));
+    const fs::path dir = fresh("deformlab-commit-stopped-stale");
+    fs::create_directories(dir / "frames");
+    write(dir / "frames" / "frame_1.png", "old");
+    for (const char* f : {"summary.txt", "state.ply", "trace.json"}) write(dir / f, "old");
+    write(dir / "manifest.json", R"({"experiment": "paper-drag"})");  // a run's
+    EXPECT_EXIT(
+        {
+          OutputDir out(dir, kOutputs, {"summary.txt"});
+          write(out.staged("summary.txt"), "new");
+          write(out.staged("manifest.json"), R"({"experiment": "new", "files": {"summary.txt": {}}})");
+          int moves = 0;
+          out.commit([&](const fs::path&) {
+            if (++moves == stop) ::_exit(3);
+          });
+        },
+        testing::ExitedWithCode(3), "");
+    {
+      OutputDir out(dir, kOutputs, all);  // would refuse an entry no manifest there names
+      if (stop == 4) EXPECT_EQ(read(dir / "summary.txt"), "new") << "the stopped commit finished";
+      for (const char* f : {"summary.txt", "state.ply", "trace.json"}) write(out.staged(f), "newer");
+      write(out.staged("manifest.json"), "newer");
+      out.commit();
+    }
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(dir)) left.push_back(e.path().filename().string());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"manifest.json", "state.ply", "summary.txt", "trace.json"}))
+        << "no old frames, staging or aside folder left";
+    fs::remove_all(dir);
+  }
 }
 
 TEST(OutputDir, CommitLeavesFilesOfAFolderThatHeldNoOutput) {
