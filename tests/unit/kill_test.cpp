@@ -7,34 +7,42 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "cli_support.hpp"
+#include "tests/support/gpu_required.hpp"
 
 namespace deformlab::test {
 namespace {
 
-// Starts `deformlab ARGS` (its stderr into `err`, if given) and sends it `sig` after `ms`
-// milliseconds (or lets it end first); returns whether the signal came before the end, and
-// the wait status in `status`.
-bool signal_after(const std::string& args, int ms, int sig, int& status, const fs::path& err = "/dev/null") {
+// Starts `deformlab ARGS` (its stdout into `out`, its stderr into `err`) and sends it `sig` once
+// `ready()` holds, asked every 5 ms (or lets it end first); returns whether the signal came
+// before the end, and the wait status in `status`.
+bool signal_when(const std::string& args, const std::function<bool()>& ready, int sig, int& status,
+                 const fs::path& err = "/dev/null", const fs::path& out = "/dev/null") {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const std::string cmd =
-        std::string("exec ") + DEFORMLAB_EXE + " " + args + " >/dev/null 2>" + err.string() + " </dev/null";
+    const std::string cmd = std::string("exec ") + DEFORMLAB_EXE + " " + args + " >" + out.string() + " 2>" +
+                            err.string() + " </dev/null";
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-  while (std::chrono::steady_clock::now() < end) {
+  while (!ready()) {
     if (::waitpid(pid, &status, WNOHANG) == pid) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   ::kill(pid, sig);
   ::waitpid(pid, &status, 0);
   return true;
+}
+
+// signal_when `ms` milliseconds have passed.
+bool signal_after(const std::string& args, int ms, int sig, int& status, const fs::path& err = "/dev/null") {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  return signal_when(args, [end] { return std::chrono::steady_clock::now() >= end; }, sig, status, err);
 }
 
 bool kill_after(const std::string& args, int ms) {
@@ -123,6 +131,25 @@ TEST_F(Cli, InterruptedSweepKeepsItsCells) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("ran " + std::to_string(12 - done) + " cells, kept " + std::to_string(done)), std::string::npos)
       << r.out;
+}
+
+// SIGINT while a GPU sweep calibrates the device stops the experiment once the calibration's
+// measurement ends, before any cell: one line and exit 130. (Calibration needs a CUDA device.)
+TEST_F(Cli, InterruptedCalibrationStopsBeforeTheCells) {
+  const fs::path file = write("cal.json", R"({"name": "cal", "base": "paper-drag", "integrator": "semi-implicit-euler",
+    "sweep": {"sizes": [64], "pipelines": ["cuda-fused"], "warmup": 2, "steps": 4, "repetitions": 1, "frames": 0}})");
+  const fs::path out = dir_ / "sweep", log = dir_ / "out.txt", err = dir_ / "err.txt";
+  int status = 0;
+  const bool signalled = signal_when(
+      "experiment " + file.string() + " --out " + out.string(),
+      [&] { return slurp(log).find("calibrating this device") != std::string::npos; }, SIGINT, status, err, log);
+  if (const std::string text = slurp(log); text.find("no calibration: ") != std::string::npos)
+    DEFORMLAB_SKIP_IF_UNAVAILABLE(text.substr(text.find("no calibration: ")));
+  ASSERT_TRUE(signalled) << "the experiment ended before it calibrated: " << slurp(log) << slurp(err);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_EQ(slurp(err), "deformlab: error: SIGINT while calibrating: the experiment stopped before its cells\n");
+  EXPECT_FALSE(fs::exists(out / "cells")) << "no cell ran";
 }
 
 TEST_F(Cli, KilledSweepCompletesWhenRunAgain) {
