@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -179,6 +180,38 @@ TEST_F(Cli, RunThatWouldFillTheDiskIsRefused) {
   EXPECT_NE(line.find(" MiB (2000 steps' timings and spans, state.ply) and its file system has 0.2"), std::string::npos)
       << line;
   EXPECT_TRUE(line.ends_with(" MiB free: free some or give another --out\n")) << line;
+}
+
+// An old manifest that cannot be removed (here a mount point: the file bound onto itself in a
+// mount namespace of the run's own) stops the commit before it changes anything: the old outputs
+// the new run lacks (state.ply, with --no-state), moved aside first, are put back, the folder is
+// as it was, and the run's outputs are in unsaved-run-PID.
+TEST_F(Cli, AManifestThatCannotBeRemovedLeavesTheFolderAsItWas) {
+  const fs::path out = dir_ / "r", err = dir_ / "err.txt";
+  ASSERT_EQ(run("run --pipeline cpu --grid 8x6 --steps 10 --out " + out.string()).code, 0);
+  std::map<std::string, std::string> before;
+  for (const auto& e : fs::directory_iterator(out)) before[e.path().filename().string()] = slurp(e.path());
+  const fs::path manifest = out / "manifest.json";
+  const std::string cmd = "command -v unshare >/dev/null || exit 99; unshare -m sh -c 'mount --bind " +
+                          manifest.string() + " " + manifest.string() + " || exit 99; " + DEFORMLAB_EXE +
+                          " run --pipeline cpu --grid 8x6 --steps 12 --no-state --out " + out.string() +
+                          " >/dev/null' 2>" + err.string();
+  const int status = std::system(cmd.c_str());
+  if (WEXITSTATUS(status) == 99 || (WEXITSTATUS(status) == 1 && slurp(err).find("unshare") != std::string::npos))
+    GTEST_SKIP() << "no bind mount in a mount namespace here: " << slurp(err);
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string line = slurp(err);
+  EXPECT_EQ(line.rfind("deformlab: error: cannot remove the manifest of output folder '" + out.string() + "' (", 0),
+            0u) << line;
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << line;
+  std::map<std::string, std::string> after;
+  fs::path kept;
+  for (const auto& e : fs::directory_iterator(out))
+    if (e.path().filename().string().starts_with("unsaved-run-")) kept = e.path();
+    else after[e.path().filename().string()] = slurp(e.path());
+  EXPECT_EQ(after, before) << "the folder as it was";
+  EXPECT_TRUE(line.ends_with("; this run's outputs are in '" + kept.string() + "'\n")) << line;
+  EXPECT_EQ(nlohmann::json::parse(slurp(kept / "manifest.json"))["result"]["steps"], 12);
 }
 
 // `deformlab mesh` writes the mesh an experiment's model generates; a scene naming that file in
