@@ -79,26 +79,31 @@ double together_bound(const Rates& r, Integrator i) {
   return root > 0.0 ? 4.0 / root : kInfinity;
 }
 
-// "dt = ... s is above <i>'s bound ..." for the first bound of `r` that dt reaches, or "".
+// "dt = ... s is above <i>'s bound ..." for the tightest bound of `r`, where dt reaches it, or "".
 std::string bound_passed(const Rates& r, const Model& m, const Params& p, Integrator i) {
   const auto bound = [](double v) {
     std::ostringstream os;
     os << std::setprecision(3) << v;
     return os.str();
   };
+  // The tightest of the bounds, where dt passes it (a springs' bound of 0, unstable at any dt, is
+  // the scheme's own note); on a tie (within rounding: without springs the joint bound is the
+  // damping's) the one that names a single cause.
+  const double d = damping_bound(r, i), k = springs_bound(r, i) > 0.0 ? springs_bound(r, i) : INFINITY,
+               t = together_bound(r, i), least = std::min({d, k, t});
+  if (!(p.dt >= least)) return "";
+  const auto tight = [least](double b) { return b <= least * (1.0 + 1e-9); };
   std::ostringstream os;
   os << "dt = " << p.dt << " s is above " << info(i).name;
-  if (const double d = damping_bound(r, i); p.dt >= d)
+  if (tight(k))
+    os << "'s stability bound dt < " << bound(k) << " s on this model's linearised springs";
+  else if (tight(d))
     os << "'s bound for the damping (global damping " << p.damping << " N s/m"
        << (m.damped() ? " and the springs' damping" : "") << ": dt < " << bound(d)
        << " s at the node damped fastest): each step can grow the velocities it damps";
-  else if (const double k = springs_bound(r, i); k > 0.0 && p.dt >= k)  // 0: unstable at any dt, the scheme's notes say
-    os << "'s stability bound dt < " << bound(k) << " s on this model's linearised springs";
-  else if (const double t = together_bound(r, i); p.dt >= t)
+  else
     os << "'s bound for the springs and the damping together (dt < " << bound(t)
        << " s, where w^2 dt^2 + 2 gamma dt = 4 on the linearised model; each alone allows a longer step)";
-  else
-    return "";
   return os.str();
 }
 
