@@ -1,6 +1,8 @@
 // The benches' shared scene, flags, statistics and CSV files (bench.hpp).
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -141,7 +143,7 @@ void add_bench_options(CLI::App& c, BenchOptions& o) {
     const auto i = parse_integrator(name);  // the paper's aliases by their names
     return i ? std::string(info(*i).name) : name;
   });
-  c.add_option("--csv", o.csv, "Also write the results to this CSV file")->check([](const std::string& file) {
+  c.add_option("--csv", o.csv, "Also write the results to this CSV file (it replaces an earlier CSV of this bench only)")->check([](const std::string& file) {
     return file.empty() ? std::string("an empty file name") : std::string();
   });
 }
@@ -178,8 +180,19 @@ CsvFile::~CsvFile() {
 CsvFile open_csv(const std::string& path, const char* header, const char* tail) {
   if (path.empty()) return {};
   require_file_target(path, "--csv");  // before anything is measured
+  const std::string first_line = std::string(header) + tail;
+  // Replaces an earlier CSV of this bench, or an empty file, and nothing else.
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) > 0) {
+    std::ifstream in(path);
+    std::string first;
+    std::getline(in, first);
+    if (first != first_line)
+      throw std::invalid_argument("--csv '" + path + "' holds a file whose first line is not this bench's header (" +
+                                  first_line + "): move it or give another file");
+  }
   CsvFile csv(path);
-  csv << header << tail << "\n";
+  csv << first_line << "\n";
   return csv;
 }
 

@@ -102,19 +102,34 @@ TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
 }
 
 // deformlab-bench's --csv file is replaced once the bench has ended well: bad input found
-// partway (a size past the node limit, after a smaller size ran) leaves the old file.
+// partway (a size past the node limit, after a smaller size ran) leaves the old file. A file
+// that is no CSV of that bench (another bench's, a run's manifest) is refused before it starts.
 TEST_F(Cli, BenchReplacesItsCsvOnlyWhenItEndsWell) {
   const fs::path csv = dir_ / "old.csv";
-  std::ofstream(csv) << "precious,data\n";
   const std::string args = "cpu --reps 2 --warmup 0 --csv " + csv.string() + " --sizes 8";
+  ASSERT_EQ(run(args, DEFORMLAB_BENCH_EXE).code, 0);
+  const std::string old = slurp(csv);
+  ASSERT_EQ(old.rfind("grid,nodes,pipeline,median_ms", 0), 0u) << old;
   const Result bad = run(args + " 100000", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(bad.code, 2) << bad.err;
-  EXPECT_EQ(slurp(csv), "precious,data\n");
+  EXPECT_EQ(slurp(csv), old);
   for (const auto& e : fs::directory_iterator(dir_))
     EXPECT_EQ(e.path().filename().string().find("old.csv."), std::string::npos) << e.path();  // no temporary left
-  const Result good = run(args, DEFORMLAB_BENCH_EXE);
+  const Result good = run(args + " 10", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(good.code, 0) << good.err;
-  EXPECT_EQ(slurp(csv).rfind("grid,nodes,pipeline,median_ms", 0), 0u) << slurp(csv);
+  EXPECT_NE(slurp(csv).find("\n10x10,"), std::string::npos) << slurp(csv);
+
+  const fs::path mine = dir_ / "mine.csv";
+  std::ofstream(mine) << "precious,data\n";
+  const Result refused = run("cpu --reps 2 --warmup 0 --sizes 8 --csv " + mine.string(), DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_EQ(refused.err.rfind("deformlab-bench: error: --csv '" + mine.string() +
+                                  "' holds a file whose first line is not this bench's header (grid,nodes,pipeline,",
+                              0),
+            0u)
+      << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_EQ(slurp(mine), "precious,data\n");
 }
 
 // The cpu bench counts its pipelines' own host memory too: an 18000 x 18000 cloth's model and
