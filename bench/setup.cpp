@@ -143,7 +143,7 @@ void add_bench_options(CLI::App& c, BenchOptions& o) {
     const auto i = parse_integrator(name);  // the paper's aliases by their names
     return i ? std::string(info(*i).name) : name;
   });
-  c.add_option("--csv", o.csv, "Also write the results to this CSV file (it replaces an earlier CSV of this bench only)")
+  c.add_option("--csv", o.csv, "Also write the results to this CSV file (replacing an earlier CSV of this bench only)")
       ->check([](const std::string& file) { return file.empty() ? std::string("an empty file name") : std::string(); });
 }
 
