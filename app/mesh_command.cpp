@@ -103,8 +103,13 @@ int mesh_command(const MeshArgs& a) {
               << ", made and written in " << duration_text(s) << " (host clock)\n"
               << "  wrote " << a.out << " (binary MSH 4.1, " << naming << " and every run reads this mesh\n";
     // The mesh is the command's output whatever the rest of the scene; what a run would refuse is said.
+    std::cout << "  reading it back to check the scene's pins and drag on it" << std::endl;
+    const auto t1 = std::chrono::steady_clock::now();
     try {
       check_mesh_file(on_written_mesh(scene, a.out));
+      std::cout << "  checked in "
+                << duration_text(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count())
+                << " (host clock)\n";
     } catch (const std::invalid_argument& e) {
       std::cerr << "deformlab: note: a run of this scene on the mesh would refuse it: " << one_line(e.what()) << "\n";
     }

@@ -229,6 +229,9 @@ TEST_F(Cli, MeshWritesAGeneratedMeshThatARunReads) {
   EXPECT_GT(node_count, 50) << made.out;
   const std::string nodes = std::to_string(node_count);
   EXPECT_NE(made.out.find("triangles, made and written in"), std::string::npos) << made.out;
+  EXPECT_NE(made.out.find("\n  reading it back to check the scene's pins and drag on it\n  checked in "),
+            std::string::npos)
+      << made.out;
   ASSERT_TRUE(fs::is_regular_file(file));
   // A folder by that name is refused, as it stands.
   fs::create_directories(dir_ / "folder.msh");
