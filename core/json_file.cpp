@@ -98,6 +98,9 @@ class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
 }  // namespace
 
 nlohmann::json parse_json(const std::string& text, const std::string& source) {
+  // The library reads a NUL byte as the end of the text and would ignore what follows it.
+  if (const auto at = text.find('\0'); at != std::string::npos)
+    throw std::invalid_argument(source + " is not valid JSON: a NUL byte at byte " + std::to_string(at + 1));
   JsonCheck check;
   nlohmann::json::sax_parse(text, &check);
   if (!check.found.empty()) throw std::invalid_argument(source + " " + check.found);

@@ -152,6 +152,8 @@ const std::vector<BadInput>& cases() {
       {"scene_empty", "run --scene {dir}/s.json", "is not valid JSON: parse error", {{"s.json", ""}}},
       {"scene_binary", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", std::string("\x01\xff\x00\x7f", 4)}}},
       {"scene_truncated", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", "{\"dt\": "}}},
+      {"scene_nul_then_text", "run --scene {dir}/s.json", "s.json' is not valid JSON: a NUL byte at byte 14",
+       {{"s.json", std::string("{\"dt\": 0.001}\0{{{", 17)}}},
       {"scene_overflow", "run --scene {dir}/s.json", "is not valid JSON: number overflow parsing '1e999'",
        {{"s.json", "{\"dt\": 1e999}"}}},
       {"scene_duplicate_key", "run --scene {dir}/s.json", "s.json' gives the key 'dt' twice in one object",
