@@ -153,6 +153,7 @@ TEST_F(Cli, BenchRefusesBadInputBeforeItPrints) {
        {std::pair{"cpu --reps 1 --warmup 0 --sizes 4 100000", "--sizes: size 100000: a model of about 1e+10 nodes exceeds "
                                                               "the limit of 2^30 nodes"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 8 4", "--sizes: size 4 is named twice"},
+        std::pair{"cpu --reps 2147483647 --sizes 4", "--reps: '2147483647' is not in 1 to 10000000"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv ''", "--csv: an empty file name"},
         std::pair{"cpu --reps 1 --warmup 0 --sizes 4 --csv /proc/x.csv",
                   "--csv '/proc/x.csv': no file can be made there"},
