@@ -50,6 +50,8 @@ Ceilings ceilings_of(const json& cal) {
   c.compute_copy_gb_s = positive_at(cal, "compute_copy", "GB_per_s");
   c.tf_vertices_s = positive_at(cal, "transform_feedback", "vertices_per_s");
   c.floor_us = positive_at(cal, "floor", "us_per_hand_off");
+  if (const json d = cal.value("device", json::object()); d.is_object() && d.value("name", json()).is_string())
+    c.device = d["name"];
   return c;
 }
 

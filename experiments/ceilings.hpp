@@ -29,6 +29,7 @@ struct Ceilings {
   double compute_copy_gb_s = 0;  // GL compute-shader copy, GB/s read + written
   double tf_vertices_s = 0;      // pass-through transform feedback, vertices/s
   double floor_us = 0;           // GL <-> CUDA semaphore ping-pong with no work, µs per hand-off
+  std::string device = "?";      // the device the calibration measured, by its name
   bool any() const { return copy_gb_s > 0 || compute_copy_gb_s > 0 || tf_vertices_s > 0 || floor_us > 0; }
 };
 

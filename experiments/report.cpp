@@ -353,10 +353,13 @@ fs::path write_report(const fs::path& dir) {
                   c.value("options", PipelineOptions{}), c.value("model", std::string()), order};
     return !ids.count(of.id()) || (manifest.contains("measurement") && !measured_as(c, manifest["measurement"], sweep));
   });
-  Report r{.dir = dir, .manifest = manifest, .sweep = sweep, .cells = std::move(cells)};
+  Report r{.dir = dir,
+           .manifest = manifest,
+           .sweep = sweep,
+           .cells = std::move(cells),
+           .ceil = ceilings_of(manifest.value("calibration", json()))};
   r.name = manifest["experiment"].value("name", std::string("experiment"));
   r.by_pipeline = r.sweep.paper_table == "table3";
-  r.ceil = ceilings_of(manifest.value("calibration", json()));
   write_setup(r);
   write_method(r);
   if (r.sweep.models.empty())

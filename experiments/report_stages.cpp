@@ -172,8 +172,9 @@ void write_ceiling_table(std::ostringstream& md, const std::vector<Column>& colu
                          const Ceilings& ceil, bool lattice) {
   const Bounded b = bounded_columns(columns, results, ceil);
   if (b.columns.empty()) return;
-  md << "Against this device's ceilings: the least time a step could take (ms) and the measured step's fraction "
-        "of it (ceiling / measured; 100% = at the ceiling).\n\n| grid |";
+  md << "Against the ceilings calibrated on " << ceil.device
+     << " (cells measured on another device do not compare): the least time a step could take (ms) and the "
+        "measured step's fraction of it (ceiling / measured; 100% = at the ceiling).\n\n| grid |";
   for (const Column* c : b.columns) md << " " << c->label << " |";
   md << "\n|---|";
   for (std::size_t k = 0; k < b.columns.size(); ++k) md << "---|";

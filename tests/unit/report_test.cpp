@@ -188,13 +188,16 @@ TEST_F(SweepTest, ReportShowsCeilingsAndStages) {
   std::string md = slurp(write_report(dir_));
   EXPECT_NE(md.find("No calibration recorded"), std::string::npos) << md;
   EXPECT_NE(md.find("- Measured cells by build: h (1), not recorded (1)\n"), std::string::npos) << md;
-  EXPECT_EQ(md.find("Against this device's ceilings"), std::string::npos) << md;
+  EXPECT_EQ(md.find("Against the ceilings"), std::string::npos) << md;
 
   manifest["calibration"] = calibration;
   std::ofstream(dir_ / "manifest.json") << manifest.dump();
   md = slurp(write_report(dir_));
   EXPECT_NE(md.find("Calibration (`deformlab calibrate`, test gpu): CUDA copy 1000.0 GB/s, compute-shader copy "
                     "500.0 GB/s on memory=cuda (400.0 GB/s on GL's buffers), transform feedback"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("Against the ceilings calibrated on test gpu (cells measured on another device do not compare): "),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| grid | cuda-fused | hybrid [interop=map] |\n|---|---|---|\n| 64² | 0.000262 (2.6%) | 0.241 (48%) |"),

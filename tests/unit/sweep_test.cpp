@@ -367,7 +367,9 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
     // Named by its path, the file reads the same scene, its mesh files from the same places.
     const Experiment by_path = load_experiment((fs::path(builtin_experiments_dir()) / (n + ".json")).string());
     EXPECT_EQ(to_json(by_path.scene), to_json(by_name.scene)) << n;
-    if (const std::string& f = by_path.scene.model.mesh.file; !f.empty()) EXPECT_TRUE(fs::exists(f)) << n << ": " << f;
+    if (const std::string& f = by_path.scene.model.mesh.file; !f.empty()) {
+      EXPECT_TRUE(fs::exists(f)) << n << ": " << f;
+    }
   }
   // `deformlab experiment`'s help names those with a sweep.
   std::set<std::string> swept;
