@@ -100,6 +100,13 @@ void require_holds_nothing_but(const fs::path& dir, Holds want) {
       throw std::invalid_argument("output folder '" + dir.string() + "' lies inside '" + up.string() + "', which holds " +
                                   (outer == Holds::run ? "a run's outputs" : "an experiment's results") +
                                   ": give this " + (want == Holds::run ? "run" : "experiment") + " another --out");
+  // A manifest that cannot be read would leave the folder taken for another kind, or for none.
+  try {
+    if (fs::exists(fs::symlink_status(dir / "manifest.json", ec)))
+      read_json_file((dir / "manifest.json").string(), "its manifest");
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("output folder '" + dir.string() + "': " + e.what() + ": move it or give another --out");
+  }
   const Holds has = folder_holds(dir);
   if (has == Holds::nothing || has == want) return;
   throw std::invalid_argument("output folder '" + dir.string() + "' holds " +

@@ -196,7 +196,9 @@ TEST(OutputDir, ACommitStoppedAnywhereLeavesNoOldOutputUnlisted) {
         testing::ExitedWithCode(3), "");
     {
       OutputDir out(dir, kOutputs, all);  // would refuse an entry no manifest there names
-      if (stop == 4) EXPECT_EQ(read(dir / "summary.txt"), "new") << "the stopped commit finished";
+      if (stop == 4) {
+        EXPECT_EQ(read(dir / "summary.txt"), "new") << "the stopped commit finished";
+      }
       for (const char* f : {"summary.txt", "state.ply", "trace.json"}) write(out.staged(f), "newer");
       write(out.staged("manifest.json"), "newer");
       out.commit();
@@ -339,6 +341,20 @@ TEST(OutputDir, AFolderHoldsOneRunOrOneExperiment) {
     EXPECT_THROW(require_holds_nothing_but(dir / "new" / "deeper", want), std::invalid_argument);
   }
   fs::remove_all(dir / "cells");
+  write(dir / "manifest.json", "{");  // cut short: said as such, not taken for another kind of folder
+  for (Holds want : {Holds::run, Holds::experiment}) {
+    try {
+      require_holds_nothing_but(dir, want);
+      ADD_FAILURE() << "a folder with an unreadable manifest was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("output folder '" + dir.string() + "': its manifest '" +
+                                                (dir / "manifest.json").string() + "' is not valid JSON: ",
+                                            0),
+                0u)
+          << e.what();
+      EXPECT_TRUE(std::string(e.what()).ends_with(": move it or give another --out")) << e.what();
+    }
+  }
   write(dir / "manifest.json", R"({"experiment": "paper-drag", "pipeline": "cpu", "build": {}, "machine": {}})");
   try {
     require_holds_nothing_but(dir / "frames", Holds::run);
