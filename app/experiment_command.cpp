@@ -105,7 +105,8 @@ int experiment_command(const ExperimentArgs& a) {
                   << c.label(lattice);
         for (const auto& [k, v] : c.options) std::cout << " " << k << "=" << v;
         if (r["status"] == "ok")
-          std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step"
+          std::cout << ": " << significant(r["median_ms"].get<double>(), 4) << " ms/step ("
+                    << r.value("step_clock", std::string("clock not recorded")) << ")"
                     << (p.kept ? " (kept)" : p.remeasured ? " (measured again: the scene or the sweep's method changed)" : "");
         else
           std::cout << ": n/a (" << r["reason"].get<std::string>() << ")"

@@ -346,8 +346,12 @@ std::string cell_problem(const json& c) {
     } catch (const json::exception&) {
       return "its \"sm_clock\" is not a clock summary";
     }
+  // Times a step can take: not negative, and finite (a report would print any number it read).
+  const auto time = [](const json& v) { return v.is_number() && v.get<double>() >= 0 && v.get<double>() < 1e30; };
+  for (const char* k : {"median_ms", "min_ms"})
+    if (c.contains(k) && !time(c[k])) return std::string("its \"") + k + "\" is not a time a step can take";
   for (const json& v : c.contains("samples_ms") ? c["samples_ms"] : json::array())
-    if (!v.is_number()) return "its \"samples_ms\" holds a value that is not a number";
+    if (!time(v)) return "its \"samples_ms\" holds a value that is not a time a step can take";
   for (const json& st : c.contains("stages") ? c["stages"] : json::array())
     if (!st.is_object() || !st.contains("name") || !st["name"].is_string() || !st.contains("clock") ||
         !st["clock"].is_string() || !st.contains("median_ms") || !st["median_ms"].is_number() ||

@@ -30,6 +30,12 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   std::ofstream(dir_ / "r" / "cells" / "x.json") << no_method.dump();
   EXPECT_NE(run(experiment + " --report-only").err.find("x.json is not a cell result (its \"method\" is of another kind)"),
             std::string::npos);
+  nlohmann::json negative = good;
+  negative["median_ms"] = -1e308;
+  std::ofstream(dir_ / "r" / "cells" / "x.json") << negative.dump();
+  EXPECT_NE(run(experiment + " --report-only").err.find("x.json is not a cell result (its \"median_ms\" is not a time a "
+                                                        "step can take)"),
+            std::string::npos);
   fs::remove(dir_ / "r" / "cells" / "x.json");
   nlohmann::json bad = good;
   bad["median_ms"] = "fast";
@@ -42,6 +48,7 @@ TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {
   const Result again = run(experiment);
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_NE(again.out.find("ran 1 cells, kept 0"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find(" ms/step (host clock)"), std::string::npos) << "each cell's time with its clock: " << again.out;
   EXPECT_TRUE(nlohmann::json::parse(slurp(cell))["median_ms"].is_number());
   nlohmann::json manifest = nlohmann::json::parse(slurp(dir_ / "r" / "manifest.json"));
   const nlohmann::json machine = manifest["machine"];
