@@ -33,9 +33,13 @@ inline std::string decimal_problem(const std::string& v, bool whole) {
   if (at != end && !(at != v.data() && *at == '-')) r = whole ? std::from_chars(at, end, n) : std::from_chars(at, end, d);
   if (r.ptr != end || r.ec == std::errc::invalid_argument)
     return "'" + v + "' is not " + (whole ? "a whole decimal number" : "a decimal number");
+  // Every whole-number flag is an int; its own check names its range where it has a narrower one.
   if (whole && (r.ec != std::errc() || n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max()))
-    return "'" + v + "' is out of range (" + std::to_string(std::numeric_limits<int>::min()) + " to " +
-           std::to_string(std::numeric_limits<int>::max()) + ")";  // every whole-number flag is an int
+    return v.starts_with('-')
+               ? "'" + v + "' is less than " + std::to_string(std::numeric_limits<int>::min()) +
+                     ", the least a whole-number option takes"
+               : "'" + v + "' is more than " + std::to_string(std::numeric_limits<int>::max()) +
+                     ", the most a whole-number option takes";
   return "";
 }
 

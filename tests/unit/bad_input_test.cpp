@@ -82,7 +82,7 @@ const std::vector<BadInput>& cases() {
       {"grid_twice", "run --grid 8x8 --grid 9x9", "--grid is given 2 times; it takes one value (see deformlab run --help)"},
       {"unknown_command", "runn --grid 4x4", "unknown command 'runn' (valid: run, experiment, list, view, calibrate, mesh)"},
       {"steps_past_int", "run --steps 99999999999",
-       "--steps: '99999999999' is out of range (-2147483648 to 2147483647) (see deformlab run --help)"},
+       "--steps: '99999999999' is more than 2147483647, the most a whole-number option takes (see deformlab run --help)"},
       {"steps_zero_padded", "run --steps +0000000000000", "--steps must be at least 1"},
       {"steps_hexadecimal", "run --steps 0x10", "--steps: '0x10' is not a whole decimal number"},
       {"steps_exponent", "run --steps 1e3", "--steps: '1e3' is not a whole decimal number"},
