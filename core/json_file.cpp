@@ -20,12 +20,13 @@ namespace {
 //   its parent;
 // - a key or string with a NUL character in it, which no name or value needs and which would
 //   cut short any message that quotes it;
+// - a key longer than kMaxKeyBytes, which no name is and which a message would quote whole;
 // - arrays and objects nested deeper than kMaxDepth, which the library's tree would copy,
 //   compare and write out by recursion, as deep as the nesting (a stack overflow at 100 000
 //   levels).
 class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
  public:
-  static constexpr std::size_t kMaxDepth = 256;
+  static constexpr std::size_t kMaxDepth = 256, kMaxKeyBytes = 256;
   std::string found;  // "gives the key 'key' twice in one object (at path)", or empty
 
   bool null() override { return value(); }
@@ -41,6 +42,11 @@ class JsonCheck : public nlohmann::json_sax<nlohmann::json> {
   bool end_array() override { return close(); }
   bool key(string_t& k) override {
     if (!no_nul(k, "a key", open_.size() - 1)) return false;
+    if (k.size() > kMaxKeyBytes) {  // no name is this long, and a message would quote it whole
+      found = "holds a key of " + std::to_string(k.size()) + " bytes" + where(open_.size() - 1) +
+              ", longer than any name it can have";
+      return false;
+    }
     Frame& f = open_.back();
     f.key = k;
     if (f.keys.insert(k).second) return true;
