@@ -450,7 +450,11 @@ bool is_scene_key(const std::string& key) {
 
 Scene load_scene(const std::string& path) {
   Scene s;
-  apply_json(s, read_json_file(path, "scene file"), path, std::filesystem::path(path).parent_path().string());
+  const json j = read_json_file(path, "scene file");
+  if (j.is_object() && (j.contains("scene") || j.contains("sweep") || j.contains("base")))
+    bad_value(path, "an experiment file (it has \"scene\", \"sweep\" or \"base\"), not a scene: give it as "
+                    "--experiment");
+  apply_json(s, j, path, std::filesystem::path(path).parent_path().string());
   return s;
 }
 

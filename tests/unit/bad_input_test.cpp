@@ -165,6 +165,8 @@ const std::vector<BadInput>& cases() {
       // A NUL would cut short every message that quotes the string or key (mesh_file_nul below).
       {"scene_nul_in_a_key", "run --scene {dir}/s.json", "s.json' holds a key with a NUL character in it (at spheres[0])",
        {{"s.json", R"({"spheres": [{"cent\u0000er": [0, 0, 0]}]})"}}},
+      {"scene_is_an_experiment", "run --scene {dir}/s.json", "s.json: an experiment file (it has \"scene\", \"sweep\" or "
+       "\"base\"), not a scene: give it as --experiment", {{"s.json", R"({"base": "quick"})"}}},
       {"scene_long_key", "run --scene {dir}/s.json", "s.json' holds a key of 100000 bytes (at model), longer than any "
        "name it can have", {{"s.json", "{\"model\": {\"" + std::string(100000, 'k') + "\": 1}}"}}},
       {"scene_nested_deep", "run --scene {dir}/s.json", "s.json' nests arrays and objects more than 256 deep",
