@@ -89,7 +89,7 @@ std::string bound_passed(const Rates& r, const Model& m, const Params& p, Integr
   // The tightest of the bounds, where dt passes it (a springs' bound of 0, unstable at any dt, is
   // the scheme's own note); on a tie (within rounding: without springs the joint bound is the
   // damping's) the one that names a single cause.
-  const double d = damping_bound(r, i), k = springs_bound(r, i) > 0.0 ? springs_bound(r, i) : INFINITY,
+  const double springs = springs_bound(r, i), k = springs > 0.0 ? springs : kInfinity, d = damping_bound(r, i),
                t = together_bound(r, i), least = std::min({d, k, t});
   if (!(p.dt >= least)) return "";
   const auto tight = [least](double b) { return b <= least * (1.0 + 1e-9); };

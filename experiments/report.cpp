@@ -91,8 +91,7 @@ void write_setup(Report& r) {
   }
   const json calibration = r.manifest.value("calibration", json());
   if (r.ceil.any()) {
-    r.md << "- Calibration (`deformlab calibrate`, "
-         << calibration.value("device", json::object()).value("name", std::string("?")) << "): CUDA copy "
+    r.md << "- Calibration (`deformlab calibrate`, " << r.ceil.device << "): CUDA copy "
          << fmt(r.ceil.copy_gb_s) << " GB/s, compute-shader copy " << fmt(r.ceil.compute_copy_gb_s) << " GB/s"
          << compute_copy_memory(calibration) << ", transform feedback " << fmt(r.ceil.tf_vertices_s * 1e-6)
          << " M vertices/s, GL <-> CUDA hand-off floor " << fmt(r.ceil.floor_us) << " µs\n";
