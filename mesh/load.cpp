@@ -177,7 +177,7 @@ class DataLost : public Assimp::LogStream {
 Mesh load_with_assimp(const std::string& path, std::vector<std::string>& notes) {
   DataLost lost;
   Assimp::Importer importer;
-  require_ply_header_end(path, importer);
+  require_ply_header(path, importer);
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
   // Positions only: the other components are dropped before the other steps.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |

@@ -3,9 +3,11 @@
 #include <assimp/Importer.hpp>
 
 #include <cctype>
+#include <charconv>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace deformlab {
@@ -63,10 +65,40 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
+// Each property value takes at least one byte in a binary PLY and two in an ASCII one (a digit
+// and a blank or line end, but for the file's last), so an element count that the rest of the
+// file cannot hold is refused before assimp's reader, which takes the count as it stands, spends
+// its CPU cap on it (a minute on 10^8 promised vertices).
+void require_ply_counts_fit(const std::string& path, const std::string& header, std::uintmax_t body_bytes) {
+  std::istringstream lines(header);
+  bool ascii = false;
+  std::uint64_t count = 0;  // of the element whose properties follow
+  double need = 0;          // bytes; exact to 2^53
+  std::string line, word, declared;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    if (!(words >> word)) continue;
+    if (word == "format") ascii = words >> word && word == "ascii";
+    if (word == "property") need += double(count) * (ascii ? 2 : 1);
+    if (word != "element") continue;
+    std::string name, number;
+    words >> name >> number;
+    const char* end = number.data() + number.size();
+    if (const auto [at, error] = std::from_chars(number.data(), end, count); error != std::errc() || at != end)
+      count = 0;  // not a count: assimp's to refuse
+    declared += (declared.empty() ? "" : ", ") + std::to_string(count) + " " + name;
+  }
+  if (ascii && need > 0) need -= 1;
+  if (need > double(body_bytes))
+    bad_mesh_file(path, "its PLY header declares " + declared + " elements, whose values take at least " +
+                            std::to_string(std::uint64_t(need)) + " bytes, where " + std::to_string(body_bytes) +
+                            " follow the header (a truncated or damaged file)");
+}
+
 // assimp's PLY reader loops for ever on a header cut off before its end_header line (the header
 // is text, within its first 64 KiB in any file we know; a file that only holds "ply" further on
 // fails assimp's PLY reader at once).
-void require_ply_header_end(const std::string& path, const Assimp::Importer& importer) {
+void require_ply_header(const std::string& path, const Assimp::Importer& importer) {
   std::ifstream in(path, std::ios::binary);
   std::string head(64 * 1024, '\0');
   in.read(head.data(), std::streamsize(head.size()));
@@ -74,8 +106,14 @@ void require_ply_header_end(const std::string& path, const Assimp::Importer& imp
   const std::string ext = extension_of(path);
   const bool magic = head.starts_with("ply") || head.starts_with("PLY");
   const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
-  if (ply && head.find("end_header") == std::string::npos)
+  if (!ply) return;
+  const std::size_t end = head.find("end_header");
+  if (end == std::string::npos)
     bad_mesh_file(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  const std::size_t body = head.find('\n', end);
+  if (!ec && body != std::string::npos) require_ply_counts_fit(path, head.substr(0, end), size - (body + 1));
 }
 
 // A skipped `v` line gives the vertices after it the numbers before, so that faces join other

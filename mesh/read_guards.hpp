@@ -17,8 +17,9 @@ namespace deformlab {
 std::string extension_of(const std::string& path);
 
 // A PLY file (by its extension or, where assimp knows no reader for its extension, by PLY's
-// magic word at its start) whose header has no end_header line in its first 64 KiB.
-void require_ply_header_end(const std::string& path, const Assimp::Importer& importer);
+// magic word at its start) whose header has no end_header line in its first 64 KiB, or declares
+// more elements than the bytes after it can hold.
+void require_ply_header(const std::string& path, const Assimp::Importer& importer);
 
 // A line of an OBJ file (read by assimp's OBJ reader) that the reader skips: a `v` line whose
 // words that it counts as numbers (those starting with a digit, '+', '-', "nan" or "inf") are not

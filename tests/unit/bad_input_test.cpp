@@ -311,8 +311,17 @@ const std::vector<BadInput>& cases() {
            ply_header("3", "1") + "list uchar int vertex_indicesxend_header\n" + std::string(36, '\0') + "\3" +
                std::string(12, '\0'),
            "m.ply"),
-      mesh("mesh_ply_count_huge", "{\"file\": \"m.ply\"}", "m.ply': ",
+      // A count is checked against the bytes after the header before assimp takes it as it stands.
+      mesh("mesh_ply_count_huge", "{\"file\": \"m.ply\"}",
+           "m.ply': its PLY header declares 4000000000 vertex, 1 face elements, whose values take at least "
+           "12000000001 bytes, where 12 follow the header (a truncated or damaged file)",
            ply_header("4000000000", "1") + "list uchar int vertex_indices\nend_header\n" + std::string(12, '\0'), "m.ply"),
+      mesh("mesh_ply_ascii_count_huge", "{\"file\": \"m.ply\"}",
+           "m.ply': its PLY header declares 100000000 vertex, 1 face elements, whose values take at least "
+           "600000001 bytes, where 26 follow the header (a truncated or damaged file)",
+           "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+           "m.ply"),
       mesh("mesh_density_tiny", "{\"file\": \"m.obj\", \"density\": 1.2e-38}", "is too small for float arithmetic"),
       mesh("mesh_non_manifold", "{\"file\": \"m.obj\"}", "is shared by 3 triangles (non-manifold; node indices from 0",
            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n"),
