@@ -45,6 +45,7 @@ struct MeshSpec {
   float cell_size = 0.f;    // fill: largest tetrahedron edge, m (0: what the surface gives)
   NodeOrder order = NodeOrder::file;
   std::uint64_t seed = 1;   // order "shuffled"
+  std::string where;        // the scene key of the layer that made the model a mesh, for errors
 };
 
 // A lattice's nodes along each axis where a scene makes one without giving its size.

@@ -284,6 +284,7 @@ void apply_model(ModelSpec& m, const json& j, const std::string& where, const st
   const bool mesh = m.topology == Topology::general;
   if (mesh && j.contains("type") && !j.contains("pins") && m.pins != PinSet::none && m.pins != PinSet::list)
     m.pins_where = where + ".pins (absent: " + (m.pins_where.empty() ? "the default" : "from " + m.pins_where) + ")";
+  if (mesh && j.contains("type")) m.mesh.where = where;
   for (const char* k : {"size", "spacing", "width", "height"})
     if (mesh && j.contains(k)) bad_value(where + "." + k, "not a key of a mesh model (its size comes from the file)");
   for (const char* k : {"file", "generate", "scale", "transform", "density", "fill", "cell_size", "order", "seed"})

@@ -57,7 +57,9 @@ Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>
     what = "generated " + std::string(to_string(ms.generate->kind));
     return generated_mesh(*ms.generate);
   }
-  if (ms.file.empty()) throw std::invalid_argument("a mesh model needs a file (model.file) or a shape (model.generate)");
+  if (ms.file.empty())
+    throw std::invalid_argument((ms.where.empty() ? "" : ms.where + ": ") +
+                                "a mesh model needs a file (\"file\") or a shape (\"generate\")");
   what = "mesh file '" + ms.file + "'";
   return load_mesh(ms.file, notes);
 }

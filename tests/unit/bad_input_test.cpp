@@ -174,6 +174,8 @@ const std::vector<BadInput>& cases() {
       // scene values
       scene("unknown_key", "{\"dtt\": 1}", "s.json.dtt: unknown key"),
       scene("unknown_model_key", "{\"model\": {\"colour\": 1}}", "s.json.model.colour: unknown key"),
+      scene("mesh_without_source", "{\"model\": {\"type\": \"mesh\"}}",
+            "s.json.model: a mesh model needs a file (\"file\") or a shape (\"generate\")"),
       scene("dt_negative_in_file", "{\"dt\": -0.001}", "s.json.dt: expected a number > 0"),
       scene("dt_string", "{\"dt\": \"fast\"}", "s.json.dt: expected a number"),
       scene("dt_float_range", "{\"dt\": 1e308}", "s.json.dt: expected a number of magnitude at most 3e38 (it is read as a float)"),
