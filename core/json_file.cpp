@@ -1,9 +1,9 @@
 #include "json_file.hpp"
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -139,9 +139,19 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
                                 std::to_string(kMaxJsonFileBytes >> 20) + " MiB a JSON file may have");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument("cannot open " + name);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_json(text.str(), name);
+  // Read to its end, whatever its size says (a file of /proc says 0), within the same cap.
+  std::string text, chunk(1 << 16, '\0');
+  errno = 0;
+  while (in.read(chunk.data(), std::streamsize(chunk.size())) || in.gcount() > 0) {
+    text.append(chunk.data(), std::size_t(in.gcount()));
+    if (std::int64_t(text.size()) > kMaxJsonFileBytes)
+      throw std::invalid_argument(name + " holds more than the " + std::to_string(kMaxJsonFileBytes >> 20) +
+                                  " MiB a JSON file may have");
+  }
+  if (in.bad())
+    throw std::invalid_argument("cannot read " + name + ": " +
+                                (errno ? std::generic_category().message(errno) : std::string("a read failed")));
+  return parse_json(text, name);
 }
 
 void bad_value(const std::string& where, const std::string& what) { throw std::invalid_argument(where + ": " + what); }

@@ -149,6 +149,8 @@ const std::vector<BadInput>& cases() {
       {"scene_missing", "run --scene {dir}/missing.json", "cannot open scene file"},
       {"scene_directory", "run --scene {dir}", "is a directory, not a JSON file"},
       {"scene_device", "run --scene /dev/zero", "scene file '/dev/zero' is not a regular file"},
+      // A regular file whose read fails (and whose size, 0, says nothing).
+      {"scene_read_fails", "run --scene /proc/self/mem", "cannot read scene file '/proc/self/mem': Input/output error"},
       {"scene_empty", "run --scene {dir}/s.json", "is not valid JSON: parse error", {{"s.json", ""}}},
       {"scene_binary", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", std::string("\x01\xff\x00\x7f", 4)}}},
       {"scene_truncated", "run --scene {dir}/s.json", "is not valid JSON", {{"s.json", "{\"dt\": "}}},
