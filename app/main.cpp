@@ -68,8 +68,8 @@ int main(int argc, char** argv) {
   deformlab::app::ExperimentArgs ex;
   ex.argv = a.argv;
   auto* experiment = cli.add_subcommand("experiment", "Run an experiment's sweep (resumable) and write its report");
-  experiment->add_option("file", ex.file, "Experiment file, or a built-in name (" + deformlab::builtin_experiment_names(true) + ")")
-      ->required();
+  const std::string sweeps = deformlab::builtin_experiment_names(deformlab::Builtins::sweeps);
+  experiment->add_option("file", ex.file, "Experiment file, or a built-in name (" + sweeps + ")")->required();
   experiment->add_option("--out,-o", ex.out, "Results folder (default: runs/<experiment name>)");
   experiment->add_option("--max-size", ex.max_size, "Leave out grid sizes above this for now (cells resume later)")
       ->check(deformlab::app::whole_in(1, 1 << 20));

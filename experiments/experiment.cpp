@@ -120,17 +120,19 @@ Experiment load_experiment_by_name(const std::string& path_or_name, const std::s
       return parse_experiment(std::string(*text), "built-in " + path_or_name + ".json", builtin_experiments_dir());
     std::error_code ec;
     if (!std::filesystem::exists(file, ec))
-      throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name +
-                                  "' (built in: " + builtin_experiment_names() + ")");
+      throw std::invalid_argument("no experiment file or built-in experiment '" + path_or_name + "' (built in: " +
+                                  builtin_experiment_names(Builtins::sweeps) + "; without a sweep, for `run "
+                                  "--experiment`: " + builtin_experiment_names(Builtins::scenes) + ")");
   }
   return load_experiment(file);
 }
 
-std::string builtin_experiment_names(bool sweeps_only) {
+std::string builtin_experiment_names(Builtins which) {
   std::string names;
   for (std::string_view file : experiment_files::names()) {
     if (!file.ends_with(".json")) continue;
-    if (sweeps_only && !json::parse(*experiment_files::find(file)).contains("sweep")) continue;
+    const bool sweep = json::parse(*experiment_files::find(file)).contains("sweep");
+    if ((which == Builtins::sweeps && !sweep) || (which == Builtins::scenes && sweep)) continue;
     names += (names.empty() ? "" : ", ") + std::string(file.substr(0, file.size() - 5));
   }
   return names;

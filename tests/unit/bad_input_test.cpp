@@ -579,6 +579,8 @@ const std::vector<BadInput>& cases() {
       {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_unknown_name", "experiment nosuch", "no experiment file or built-in experiment 'nosuch' (built in: "},
+      {"experiment_unknown_name_lists_scenes_apart", "experiment nosuch", "tiles; without a sweep, for `run --experiment`: "
+       "paper-drag)"},
       {"run_unknown_experiment", "run --experiment tabel2", "no experiment file or built-in experiment 'tabel2'"},
       {"report_max_size", "experiment quick --report-only --max-size 4", "--max-size limits the cells a run measures"},
       {"experiment_max_size_zero", "experiment quick --max-size 0", "--max-size: '0' is not in 1 to 1048576"},

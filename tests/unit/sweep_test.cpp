@@ -373,7 +373,7 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
   }
   // `deformlab experiment`'s help names those with a sweep.
   std::set<std::string> swept;
-  std::stringstream sweeps(builtin_experiment_names(true));
+  std::stringstream sweeps(builtin_experiment_names(Builtins::sweeps));
   for (std::string n; std::getline(sweeps >> std::ws, n, ',');) swept.insert(n);
   for (const std::string& n : files) {
     const Experiment x = load_experiment_by_name(n);
@@ -384,6 +384,7 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
     }
   }
   EXPECT_EQ(swept.count("paper-drag"), 0u);
+  EXPECT_EQ(builtin_experiment_names(Builtins::scenes), "paper-drag");
 }
 
 // A file without a "name" is named by its file name, as its results folder is.
