@@ -75,11 +75,7 @@ int mesh_command(const MeshArgs& a) {
     namespace fs = std::filesystem;
     if (fs::path(a.out).extension() != ".msh")
       throw std::invalid_argument("--out '" + a.out + "': expected a file name ending in .msh");
-    require_name_lengths(a.out, "--out");
-    if (std::error_code ec; fs::is_directory(a.out, ec)) throw std::invalid_argument("--out '" + a.out + "' is a folder");
-    // Its folders are made as it is written; where they are, a file must be possible there.
-    if (std::error_code ec; fs::is_directory(fs::absolute(a.out).parent_path(), ec))
-      require_file_can_be_made(a.out, "--out");
+    require_file_target(a.out, "--out");
     Scene scene = chosen_scene(a);
     scene.model.mesh.order = NodeOrder::file;  // written as Gmsh makes it: a run orders the nodes it reads
     const MeshSpec& ms = scene.model.mesh;

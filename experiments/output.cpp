@@ -130,18 +130,21 @@ void require_file_target(const std::string& file, const std::string& what) {
   std::error_code ec;
   if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
   require_name_lengths(file, what);
-  const fs::path folder = fs::path(file).parent_path();
   if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
-  if (!folder.empty() && !fs::is_directory(folder, ec))
-    throw std::invalid_argument(what + " '" + file + "': no folder '" + folder.string() + "'");
   require_file_can_be_made(file, what);
 }
 
 void require_file_can_be_made(const std::string& file, const std::string& what) {
   std::error_code ec;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return;  // a pipe, a device: written to as it is
-  // Its temporary, made and removed again.
-  const fs::path probe = temporary(file);
+  // Its folders are made as it is written: the nearest that is there must be a folder.
+  fs::path folder = fs::path(file).parent_path();
+  while (!folder.empty() && !fs::exists(fs::symlink_status(folder, ec)) && folder.has_relative_path())
+    folder = folder.parent_path();
+  if (!folder.empty() && !fs::is_directory(folder, ec))
+    throw std::invalid_argument(what + " '" + file + "': '" + folder.string() + "' is not a folder");
+  // A temporary of its name in that folder, made and removed again.
+  const fs::path probe = temporary(folder / fs::path(file).filename());
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
   if (fd < 0)
     throw std::invalid_argument(what + " '" + file + "': no file can be made there (" + std::strerror(errno) + ")");
@@ -154,6 +157,8 @@ void write_atomically(const fs::path& file, const std::string& text) {
   std::error_code ec;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return write(file);  // a pipe, a device: written to
   const fs::path tmp = temporary(file);
+  if (file.has_parent_path() && (fs::create_directories(file.parent_path(), ec), ec))
+    throw write_error(file.string(), ec.value());
   try {
     write(tmp);
   } catch (const std::runtime_error& e) {  // named as the file asked for

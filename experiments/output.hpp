@@ -45,19 +45,19 @@ void require_holds_nothing_but(const std::filesystem::path& dir, Holds want);
 std::string foreign_frames_entry(const std::filesystem::path& frames);
 
 // Throws std::invalid_argument where `file`, named by `what` (a flag), could not be written: an
-// empty name, a name too long, a folder in its place, no folder to hold it, or one where no file
-// can be made.
+// empty name, a name too long, a folder in its place, or require_file_can_be_made's causes.
 void require_file_target(const std::string& file, const std::string& what);
-// Throws std::invalid_argument, naming `what`, where no file can be made in the existing folder
-// that is to hold `file` (one the process may not write, a file system that takes none).
+// Throws std::invalid_argument, naming `what`, where no file can be made in the folder that is to
+// hold `file`, or, where that folder is not there yet, in the nearest folder above it that is
+// (one the process may not write, a file system that takes none), or where that is a file.
 void require_file_can_be_made(const std::string& file, const std::string& what);
 // The temporary name of `name` for this process: "<name>.deformlab-tmp-<pid>". The names of
 // temporaries and staging folders (".deformlab-staging-<pid>") are ours alone: a folder's other
 // files are never taken for them.
 std::filesystem::path temporary(const std::filesystem::path& name);
-// Writes `file` whole or not at all: into its temporary, renamed over it once written (on a
-// failure the temporary is removed and write_error's words thrown, naming `file`). A file
-// there that is no regular file (a pipe, a device) is written to as it is.
+// Writes `file` whole or not at all, making its folders: into its temporary, renamed over it
+// once written (on a failure the temporary is removed and write_error's words thrown, naming
+// `file`). A file there that is no regular file (a pipe, a device) is written to as it is.
 void write_atomically(const std::filesystem::path& file, const std::string& text);
 // Whether `name` is a temporary's.
 bool is_temporary(const std::string& name);

@@ -23,9 +23,10 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
     : file_(std::move(file)), partial_(file_ + ".partial-" + std::to_string(getpid())), w_(width), h_(height) {
   if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
     throw std::invalid_argument("recording needs ffmpeg, which is not installed");
-  const auto dir = std::filesystem::path(file_).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir))
-    throw std::invalid_argument("cannot record into " + file_ + ": no folder " + dir.string());
+  std::error_code ec;
+  if (const auto dir = std::filesystem::path(file_).parent_path(); !dir.empty())
+    if (std::filesystem::create_directories(dir, ec); ec)
+      throw std::invalid_argument("cannot record into " + file_ + ": " + ec.message());
   std::signal(SIGPIPE, SIG_IGN);  // a failed ffmpeg shows as a write error, not a dead viewer
   // H.264 in yuv420p wants even sizes: an odd last row or column is cut. In a session of its
   // own (setsid), so that a terminal's Ctrl-C reaches the viewer, which finishes the recording,

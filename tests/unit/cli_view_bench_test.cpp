@@ -102,8 +102,9 @@ TEST_F(Cli, BenchRefusesASizeThatDoesNotFitTheHost) {
 }
 
 // deformlab-bench's --csv file is replaced once the bench has ended well: bad input found
-// partway (a size past the node limit, after a smaller size ran) leaves the old file. A file
-// that is no CSV of that bench (another bench's, a run's manifest) is refused before it starts.
+// partway (a size past the node limit, after a smaller size ran) leaves the old file, and makes
+// no folder for a new one. A file that is no CSV of that bench (another bench's, a run's
+// manifest) is refused before it starts.
 TEST_F(Cli, BenchReplacesItsCsvOnlyWhenItEndsWell) {
   const fs::path csv = dir_ / "old.csv";
   const std::string args = "cpu --reps 2 --warmup 0 --csv " + csv.string() + " --sizes 8";
@@ -118,6 +119,12 @@ TEST_F(Cli, BenchReplacesItsCsvOnlyWhenItEndsWell) {
   const Result good = run(args + " 10", DEFORMLAB_BENCH_EXE);
   EXPECT_EQ(good.code, 0) << good.err;
   EXPECT_NE(slurp(csv).find("\n10x10,"), std::string::npos) << slurp(csv);
+  const fs::path deep = dir_ / "new" / "deeper" / "b.csv";
+  EXPECT_EQ(run("cpu --reps 2 --warmup 0 --sizes 8 100000 --csv " + deep.string(), DEFORMLAB_BENCH_EXE).code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "new"));
+  const Result made = run("cpu --reps 2 --warmup 0 --sizes 8 --csv " + deep.string(), DEFORMLAB_BENCH_EXE);
+  EXPECT_EQ(made.code, 0) << made.err;
+  EXPECT_EQ(slurp(deep).rfind("grid,nodes,pipeline,median_ms", 0), 0u) << slurp(deep);
 
   const fs::path mine = dir_ / "mine.csv";
   std::ofstream(mine) << "precious,data\n";

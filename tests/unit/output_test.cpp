@@ -294,8 +294,8 @@ TEST(OutputFiles, AFailedWriteSaysWhy) {
   }
 }
 
-// write_atomically replaces a regular file whole, names that file (not its temporary) when it
-// fails, and writes to what is no regular file (a pipe, a device) as it is.
+// write_atomically replaces a regular file whole, makes its folders, names that file (not its
+// temporary) when it fails, and writes to what is no regular file (a pipe, a device) as it is.
 TEST(OutputFiles, WrittenWholeOrNotAtAll) {
   const fs::path dir = fs::temp_directory_path() / ("deformlab-atomic-" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -306,13 +306,16 @@ TEST(OutputFiles, WrittenWholeOrNotAtAll) {
   fs::create_symlink("/dev/null", dir / "sink");
   write_atomically(dir / "sink", "x");
   EXPECT_TRUE(fs::is_symlink(dir / "sink")) << "the link, and the device behind it, stay";
+  write_atomically(dir / "new" / "deeper" / "b.json", "made");
+  std::ifstream made(dir / "new" / "deeper" / "b.json");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(made), {}), "made");
   try {
-    write_atomically(dir / "none" / "b.json", "x");
+    write_atomically(dir / "a.json" / "b.json", "x");
     ADD_FAILURE() << "written";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "none" / "b.json").string() + ": No such file or directory");
+    EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "a.json" / "b.json").string() + ": Not a directory");
   }
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2) << "no temporary left";
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3) << "no temporary left";
   fs::remove_all(dir);
 }
 

@@ -221,15 +221,17 @@ TEST_F(View, KeysTakeScreenshotsAndRecordingsIntoTheWorkingFolder) {
 
 TEST_F(View, RefusesBadInputWithOneLine) {
   const fs::path bad = write("bad.json", R"({"events": [{"frame": 1, "event": "teleport"}]})");
-  const fs::path shot = write("shot.json", R"({"events": [{"frame": 1, "event": "screenshot", "file": "nodir/x.png"}]})");
+  const fs::path shot = write("shot.json", nlohmann::json{{"events", {{{"frame", 1}, {"event", "screenshot"},
+                                                                       {"file", (bad / "x.png").string()}}}}}.dump());
   const std::string same = (dir_ / "same.json").string();
   for (const auto& [args, needle] : std::vector<std::pair<std::string, std::string>>{
            {"--steps-per-frame 0", "--steps-per-frame"},
-           {"--summary " + (dir_ / "nodir" / "s.json").string(), "--summary '" + (dir_ / "nodir" / "s.json").string() + "': no folder"},
+           {"--summary " + (bad / "s.json").string(), "--summary '" + (bad / "s.json").string() + "': '" + bad.string() +
+                                                           "' is not a folder"},
            {"--summary " + same + " --save-script " + same, "--save-script '" + same + "' is a file another flag names too"},
            {"--script " + bad.string() + " --summary " + bad.string(), "is a file another flag names too"},
            {"--summary ''", "--summary: an empty file name"},
-           {"--script " + shot.string(), "screenshot 'nodir/x.png': no folder 'nodir'"},
+           {"--script " + shot.string(), "screenshot '" + (bad / "x.png").string() + "': '" + bad.string() + "' is not a folder"},
            {"--seconds 2", "--seconds needs --record"},
            {"--size 640", "--size"},
            {"--script " + bad.string(), "unknown event 'teleport'"},
