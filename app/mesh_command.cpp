@@ -2,7 +2,6 @@
 // scene can name as its model's "file", so that runs share one mesh.
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <stdexcept>
 
@@ -11,6 +10,7 @@
 #include "core/one_line.hpp"
 #include "experiments/output.hpp"
 #include "experiments/sweep_models.hpp"
+#include "mesh/load.hpp"
 #include "mesh/scene_model.hpp"
 
 namespace deformlab::app {
@@ -50,10 +50,7 @@ void require_replaceable_mesh(const std::string& out, const MeshSpec& ms) {
   if (!ms.file.empty() && fs::equivalent(out, ms.file, ec))
     throw std::invalid_argument("--out '" + out + "' is the mesh file the model is filled from (model.file): name "
                                 "another file");
-  std::ifstream in(out, std::ios::binary);
-  std::string head(12, '\0');
-  in.read(head.data(), std::streamsize(head.size()));
-  if (!head.starts_with("$MeshFormat"))
+  if (!starts_as_gmsh_mesh(out))
     throw std::invalid_argument("--out '" + out + "' holds a file that is not a Gmsh mesh (it does not start with "
                                 "$MeshFormat), which this would replace: remove it or name another file");
 }

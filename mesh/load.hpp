@@ -25,6 +25,10 @@ struct WriteError : std::invalid_argument {
 // Throws std::invalid_argument naming the file and the problem.
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 
+// Whether the file starts as a Gmsh mesh does: with "$MeshFormat" (or MSH 1's "$NOD" or "$NOE").
+// Gmsh reads a .msh file that does not as a .geo script.
+bool starts_as_gmsh_mesh(const std::string& path);
+
 // The closed surface filled with tetrahedra (Gmsh, its nodes kept); cell_size > 0 caps the
 // tetrahedra's edges. With `save_to`, Gmsh also writes the filled mesh there (write_gmsh_model).
 // Throws std::invalid_argument when Gmsh cannot fill it, WriteError when it cannot write it.

@@ -300,6 +300,10 @@ const std::vector<BadInput>& cases() {
            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n",
            "m.ply"),
+      // Gmsh reads a .msh file that does not start as a mesh as a .geo script ("Unknown variable 'world'").
+      mesh("mesh_msh_not_a_mesh", "{\"file\": \"m.msh\"}",
+           "m.msh': not a Gmsh mesh: it does not start with $MeshFormat (Gmsh would read it as a script)",
+           "hello world\n", "m.msh"),
       mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            "ply\nformat ascii 1.0\n", "m.ply"),
       // assimp clamps an OFF face's index out of range and says so only in its log.
