@@ -36,7 +36,7 @@ int calibrate_command(const CalibrateArgs& a) {
     if (a.out) require_file_target(*a.out, "--out");  // before the measurement, which takes seconds
     const nlohmann::json j = measure_calibration(a.argv);
     if (a.out) {
-      write_json(*a.out, j);
+      write_atomically(*a.out, j.dump(2) + "\n");
       std::cerr << "  wrote " << *a.out << "\n";
     } else {
       std::cout << j.dump(2) << "\n";

@@ -52,7 +52,8 @@ void require_replaceable_mesh(const std::string& out, const MeshSpec& ms) {
                                 "another file");
   if (!starts_as_gmsh_mesh(out))
     throw std::invalid_argument("--out '" + out + "' holds a file that is not a Gmsh mesh (it does not start with "
-                                "$MeshFormat), which this would replace: remove it or name another file");
+                                "$MeshFormat or another section Gmsh reads as a mesh), which this would replace: "
+                                "remove it or name another file");
 }
 
 // The scene as it names the written mesh, in place of "generate" or of the fill and placement

@@ -132,7 +132,7 @@ std::string builtin_experiment_names(Builtins which) {
   for (std::string_view file : experiment_files::names()) {
     if (!file.ends_with(".json")) continue;
     const bool sweep = json::parse(*experiment_files::find(file)).contains("sweep");
-    if ((which == Builtins::sweeps && !sweep) || (which == Builtins::scenes && sweep)) continue;
+    if (sweep != (which == Builtins::sweeps)) continue;
     names += (names.empty() ? "" : ", ") + std::string(file.substr(0, file.size() - 5));
   }
   return names;

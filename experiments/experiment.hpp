@@ -37,11 +37,11 @@ Experiment load_experiment(const std::string& path);
 // A name that is neither is bad input naming the built-in ones. A relative file is taken from
 // folder `from` (an experiment file's, for its "base") where it is given.
 Experiment load_experiment_by_name(const std::string& path_or_name, const std::string& from = "");
-// The names of the experiments built into the binary (experiments/*.json), comma-separated:
-// "gl-memory, interop, ...": all, those with a sweep (`deformlab experiment`'s), or those without
-// (scenes for `deformlab run --experiment`).
-enum class Builtins { all, sweeps, scenes };
-std::string builtin_experiment_names(Builtins which = Builtins::all);
+// The names of the experiments built into the binary (experiments/*.json) with a sweep
+// (`deformlab experiment`'s) or without one (scenes for `deformlab run --experiment`),
+// comma-separated: "gl-memory, interop, ...".
+enum class Builtins { sweeps, scenes };
+std::string builtin_experiment_names(Builtins which);
 // The experiments/ folder of the source tree this binary was built in: the first folder above
 // the running executable that holds data/ and experiments/ (a build inside a tree, wherever the
 // tree was moved), else the source tree it was configured from.

@@ -84,6 +84,17 @@ Holds manifest_holds(const fs::path& dir, bool written = false) {
   return m["experiment"].is_object() ? Holds::experiment : Holds::run;
 }
 
+// The folders that creating `dir` makes, as absolute paths through the links that exist now,
+// the deepest first.
+std::vector<fs::path> folders_to_make(const fs::path& dir) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  if (!p.has_filename()) p = p.parent_path();
+  std::vector<fs::path> made;
+  for (; !ec && p.has_relative_path() && !fs::exists(p, ec); p = p.parent_path()) made.push_back(p);
+  return made;
+}
+
 }  // namespace
 
 Holds folder_holds(const fs::path& dir) {
@@ -131,6 +142,8 @@ void require_file_target(const std::string& file, const std::string& what) {
   if (file.empty()) throw std::invalid_argument(what + ": an empty file name");
   require_name_lengths(file, what);
   if (fs::is_directory(file, ec)) throw std::invalid_argument(what + " '" + file + "' is a folder");
+  if (!fs::path(file).has_filename())
+    throw std::invalid_argument(what + " '" + file + "' names a folder (it ends in '/'), not a file");
   require_file_can_be_made(file, what);
 }
 
@@ -157,20 +170,28 @@ void write_atomically(const fs::path& file, const std::string& text) {
   std::error_code ec;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return write(file);  // a pipe, a device: written to
   const fs::path tmp = temporary(file);
-  if (file.has_parent_path() && (fs::create_directories(file.parent_path(), ec), ec))
-    throw write_error(file.string(), ec.value());
+  const std::vector<fs::path> made = folders_to_make(file.parent_path());
+  auto unmake = [&] {  // the folders made for it, the deepest first
+    for (const fs::path& f : made) fs::remove(f, ec);
+  };
+  if (!made.empty() && (fs::create_directories(file.parent_path(), ec), ec)) {
+    const int error = ec.value();
+    unmake();
+    throw write_error(file.string(), error);
+  }
   try {
     write(tmp);
   } catch (const std::runtime_error& e) {  // named as the file asked for
     fs::remove(tmp, ec);
+    unmake();
     std::string what = e.what();
     if (const auto at = what.find(tmp.string()); at != std::string::npos) what.replace(at, tmp.string().size(), file.string());
     throw std::runtime_error(what);
   }
   if (std::rename(tmp.c_str(), file.c_str()) != 0) {
     const int error = errno;
-    std::error_code ec;
     fs::remove(tmp, ec);
+    unmake();
     throw write_error(file.string(), error);
   }
 }
@@ -209,17 +230,6 @@ void finish_stopped_commit(const fs::path& dir) {
     fs::rename(e.path() / "manifest.json", dir / "manifest.json");
     return;
   }
-}
-
-// The folders that creating `dir` makes, as absolute paths through the links that exist now,
-// the deepest first.
-std::vector<fs::path> folders_to_make(const fs::path& dir) {
-  std::error_code ec;
-  fs::path p = fs::weakly_canonical(fs::absolute(dir, ec), ec);
-  if (!p.has_filename()) p = p.parent_path();
-  std::vector<fs::path> made;
-  for (; !ec && p.has_relative_path() && !fs::exists(p, ec); p = p.parent_path()) made.push_back(p);
-  return made;
 }
 
 }  // namespace

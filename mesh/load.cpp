@@ -380,7 +380,8 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
   return read_in_child(what, child_read_limits(std::int64_t(size)), [&](std::vector<std::string>& read_notes) {
     if (extension_of(path) != ".msh") return load_with_assimp(path, read_notes);
     if (!starts_as_gmsh_mesh(path))
-      bad_mesh_file(path, "not a Gmsh mesh: it does not start with $MeshFormat (Gmsh would read it as a script)");
+      bad_mesh_file(path, "not a Gmsh mesh: it does not start with $MeshFormat or another section Gmsh reads as a "
+                          "mesh (Gmsh would read it as a .geo script)");
     GmshSession gmsh;
     Mesh m;
     GmshSession::run(what, [&] {
@@ -395,7 +396,9 @@ bool starts_as_gmsh_mesh(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string head(11, '\0');
   in.read(head.data(), std::streamsize(head.size()));
-  return head.starts_with("$MeshFormat") || head.starts_with("$NOD") || head.starts_with("$NOE");
+  for (const char* section : {"$MeshFormat", "$Comments", "$NO", "$ELM", "$PTS", "$PARA"})
+    if (head.starts_with(section)) return true;
+  return false;
 }
 
 Mesh fill_tetrahedra(const Mesh& surface, float cell_size, const std::string& save_to) {

@@ -25,8 +25,9 @@ struct WriteError : std::invalid_argument {
 // Throws std::invalid_argument naming the file and the problem.
 Mesh load_mesh(const std::string& path, std::vector<std::string>& notes);
 
-// Whether the file starts as a Gmsh mesh does: with "$MeshFormat" (or MSH 1's "$NOD" or "$NOE").
-// Gmsh reads a .msh file that does not as a .geo script.
+// Whether the file starts with a section that Gmsh reads as a mesh ("$MeshFormat", "$Comments",
+// or an older format's "$NO", "$ELM", "$PTS", "$PARA"): Gmsh reads any other .msh file as a
+// .geo script.
 bool starts_as_gmsh_mesh(const std::string& path);
 
 // The closed surface filled with tetrahedra (Gmsh, its nodes kept); cell_size > 0 caps the

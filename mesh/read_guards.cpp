@@ -3,7 +3,6 @@
 #include <assimp/Importer.hpp>
 
 #include <cctype>
-#include <charconv>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -53,6 +52,37 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
              "keeps 3, 4 or 6, counting the words that start with a digit, + or -: write .5 as 0.5)");
 }
 
+// Each property value takes at least one byte in a binary PLY and two in an ASCII one (a digit
+// and a blank or line end, but for the file's last), so an element count that the rest of the
+// file cannot hold is refused before assimp's reader, which takes the count as it stands, spends
+// its CPU cap on it (a minute on 10^8 promised vertices). A count is read as assimp reads it:
+// its leading digits, in 32 bits (wrapping).
+void require_ply_counts_fit(const std::string& path, const std::string& header, std::uintmax_t body_bytes) {
+  std::istringstream lines(header);
+  bool ascii = false;
+  std::uint32_t count = 0;  // of the element whose properties follow
+  std::uint64_t need = 0;   // bytes: at most 2 (2^32 - 1) a property line, exact in 64 bits
+  std::string line, word, declared;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    if (!(words >> word)) continue;
+    if (word == "format") ascii = words >> word && word == "ascii";
+    if (word == "property") need += std::uint64_t(count) * (ascii ? 2 : 1);
+    if (word != "element") continue;
+    std::string name, number;
+    words >> name >> number;
+    count = 0;
+    for (std::size_t k = 0; k < number.size() && std::isdigit(static_cast<unsigned char>(number[k])); ++k)
+      count = count * 10 + std::uint32_t(number[k] - '0');
+    declared += (declared.empty() ? "" : ", ") + std::to_string(count) + " " + name;
+  }
+  if (ascii && need > 0) need -= 1;
+  if (need > body_bytes)
+    bad_mesh_file(path, "its PLY header declares " + declared + " elements, whose values take at least " +
+                            std::to_string(need) + " bytes, where " + std::to_string(body_bytes) +
+                            " follow the header (a truncated or damaged file)");
+}
+
 }  // namespace
 
 void bad_mesh_file(const std::string& file, const std::string& what) {
@@ -63,36 +93,6 @@ std::string extension_of(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   return ext;
-}
-
-// Each property value takes at least one byte in a binary PLY and two in an ASCII one (a digit
-// and a blank or line end, but for the file's last), so an element count that the rest of the
-// file cannot hold is refused before assimp's reader, which takes the count as it stands, spends
-// its CPU cap on it (a minute on 10^8 promised vertices).
-void require_ply_counts_fit(const std::string& path, const std::string& header, std::uintmax_t body_bytes) {
-  std::istringstream lines(header);
-  bool ascii = false;
-  std::uint64_t count = 0;  // of the element whose properties follow
-  double need = 0;          // bytes; exact to 2^53
-  std::string line, word, declared;
-  while (std::getline(lines, line)) {
-    std::istringstream words(line);
-    if (!(words >> word)) continue;
-    if (word == "format") ascii = words >> word && word == "ascii";
-    if (word == "property") need += double(count) * (ascii ? 2 : 1);
-    if (word != "element") continue;
-    std::string name, number;
-    words >> name >> number;
-    const char* end = number.data() + number.size();
-    if (const auto [at, error] = std::from_chars(number.data(), end, count); error != std::errc() || at != end)
-      count = 0;  // not a count: assimp's to refuse
-    declared += (declared.empty() ? "" : ", ") + std::to_string(count) + " " + name;
-  }
-  if (ascii && need > 0) need -= 1;
-  if (need > double(body_bytes))
-    bad_mesh_file(path, "its PLY header declares " + declared + " elements, whose values take at least " +
-                            std::to_string(std::uint64_t(need)) + " bytes, where " + std::to_string(body_bytes) +
-                            " follow the header (a truncated or damaged file)");
 }
 
 // assimp's PLY reader loops for ever on a header cut off before its end_header line (the header

@@ -302,7 +302,8 @@ const std::vector<BadInput>& cases() {
            "m.ply"),
       // Gmsh reads a .msh file that does not start as a mesh as a .geo script ("Unknown variable 'world'").
       mesh("mesh_msh_not_a_mesh", "{\"file\": \"m.msh\"}",
-           "m.msh': not a Gmsh mesh: it does not start with $MeshFormat (Gmsh would read it as a script)",
+           "m.msh': not a Gmsh mesh: it does not start with $MeshFormat or another section Gmsh reads as a mesh (Gmsh "
+           "would read it as a .geo script)",
            "hello world\n", "m.msh"),
       mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            "ply\nformat ascii 1.0\n", "m.ply"),
@@ -324,6 +325,13 @@ const std::vector<BadInput>& cases() {
            "m.ply': its PLY header declares 4000000000 vertex, 1 face elements, whose values take at least "
            "12000000001 bytes, where 12 follow the header (a truncated or damaged file)",
            ply_header("4000000000", "1") + "list uchar int vertex_indices\nend_header\n" + std::string(12, '\0'), "m.ply"),
+      // assimp reads a count's leading digits.
+      mesh("mesh_ply_count_with_a_tail", "{\"file\": \"m.ply\"}",
+           "m.ply': its PLY header declares 100000000 vertex, 1 face elements, whose values take at least "
+           "600000001 bytes, where 26 follow the header (a truncated or damaged file)",
+           "ply\nformat ascii 1.0\nelement vertex 100000000x\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+           "m.ply"),
       mesh("mesh_ply_ascii_count_huge", "{\"file\": \"m.ply\"}",
            "m.ply': its PLY header declares 100000000 vertex, 1 face elements, whose values take at least "
            "600000001 bytes, where 26 follow the header (a truncated or damaged file)",
@@ -475,6 +483,7 @@ const std::vector<BadInput>& cases() {
       {"calibrate_out_under_a_file", "calibrate --out {dir}/s.json/deeper/c.json", "/s.json' is not a folder",
        {{"s.json", "{}"}}},
       {"calibrate_out_a_folder", "calibrate --out {dir}", "' is a folder"},
+      {"calibrate_out_ends_in_slash", "calibrate --out {dir}/new/", "new/' names a folder (it ends in '/'), not a file"},
       scene("grid_mesh_key", "{\"model\": {\"file\": \"m.obj\"}}", "s.json.model.file: a key of mesh models"),
       scene("drag_node_box", "{\"drag\": {\"node\": {\"box\": [[0, 0, 0], [1, 1, 1]]}}}",
             "s.json.drag.node: expected a node index, \"center\" or {\"nearest\": [x, y, z]}"),
@@ -584,7 +593,7 @@ const std::vector<BadInput>& cases() {
       {"experiment_directory", "experiment {dir}", "is a directory, not a JSON file"},
       {"experiment_missing", "experiment {dir}/none.json", "cannot open experiment file"},
       {"experiment_unknown_name", "experiment nosuch", "no experiment file or built-in experiment 'nosuch' (built in: "},
-      {"experiment_unknown_name_lists_scenes_apart", "experiment nosuch", "tiles; without a sweep, for `run --experiment`: "
+      {"experiment_unknown_name_lists_scenes_apart", "experiment nosuch", "; without a sweep, for `run --experiment`: "
        "paper-drag)"},
       {"run_unknown_experiment", "run --experiment tabel2", "no experiment file or built-in experiment 'tabel2'"},
       {"report_max_size", "experiment quick --report-only --max-size 4", "--max-size limits the cells a run measures"},

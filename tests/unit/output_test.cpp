@@ -309,6 +309,12 @@ TEST(OutputFiles, WrittenWholeOrNotAtAll) {
   write_atomically(dir / "new" / "deeper" / "b.json", "made");
   std::ifstream made(dir / "new" / "deeper" / "b.json");
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(made), {}), "made");
+  try {  // a name too long fails after its folders are made: they go again
+    write_atomically(dir / "made" / "here" / std::string(300, 'x'), "x");
+    ADD_FAILURE() << "written";
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_FALSE(fs::exists(dir / "made"));
   try {
     write_atomically(dir / "a.json" / "b.json", "x");
     ADD_FAILURE() << "written";

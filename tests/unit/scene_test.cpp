@@ -1,11 +1,15 @@
 // Scene and experiment files: every key read, unknown keys and bad values named.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <tuple>
 
 #include <nlohmann/json.hpp>
 
+#include "core/json_file.hpp"
 #include "core/scene.hpp"
 #include "experiments/experiment.hpp"
 #include "mesh/scene_model.hpp"
@@ -162,6 +166,25 @@ TEST(Scene, AGeneratedMeshTakesFillNone) {
                                 "generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.25}}})"), "a");
   EXPECT_FALSE(s.model.mesh.fill);
   EXPECT_TRUE(s.model.mesh.generate.has_value());
+}
+
+// A JSON file is read up to its cap whatever its size says: one of the cap's bytes is read, one
+// byte more is refused.
+TEST(Scene, AJsonFileOverTheCapIsRefused) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / ("deformlab-cap-" + std::to_string(::getpid()) + ".json");
+  std::string text(std::size_t(kMaxJsonFileBytes), ' ');
+  text.front() = '1';
+  std::ofstream(file, std::ios::binary) << text;
+  EXPECT_EQ(read_json_file(file.string(), "scene file"), 1);
+  std::ofstream(file, std::ios::binary | std::ios::app) << ' ';
+  try {
+    read_json_file(file.string(), "scene file");
+    ADD_FAILURE() << "read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "scene file '" + file.string() + "' holds more than the 16 MiB a JSON file may have");
+  }
+  fs::remove(file);
 }
 
 TEST(Scene, ErrorsNameTheKey) {
