@@ -95,9 +95,10 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-// assimp's PLY reader loops for ever on a header cut off before its end_header line (the header
-// is text, within its first 64 KiB in any file we know; a file that only holds "ply" further on
-// fails assimp's PLY reader at once).
+// assimp's PLY reader loops for ever on a header without an end_header line, one whose first
+// word is end_header ("end_headers" or "comment end_header" is none). The header is text, within
+// its first 64 KiB in any file we know; a file that only holds "ply" further on fails assimp's
+// PLY reader at once.
 void require_ply_header(const std::string& path, const Assimp::Importer& importer) {
   std::ifstream in(path, std::ios::binary);
   std::string head(64 * 1024, '\0');
@@ -107,13 +108,19 @@ void require_ply_header(const std::string& path, const Assimp::Importer& importe
   const bool magic = head.starts_with("ply") || head.starts_with("PLY");
   const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
   if (!ply) return;
-  const std::size_t end = head.find("end_header");
-  if (end == std::string::npos)
-    bad_mesh_file(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  const std::size_t body = head.find('\n', end);
-  if (!ec && body != std::string::npos) require_ply_counts_fit(path, head.substr(0, end), size - (body + 1));
+  for (std::size_t at = 0; at < head.size();) {
+    const std::size_t line_end = std::min(head.find('\n', at), head.size());
+    std::istringstream words(head.substr(at, line_end - at));
+    if (std::string first; words >> first && first == "end_header") {
+      std::error_code ec;
+      const std::uintmax_t size = std::filesystem::file_size(path, ec);
+      const std::size_t body = std::min(line_end + 1, head.size());
+      if (!ec) require_ply_counts_fit(path, head.substr(0, at), size - body);
+      return;
+    }
+    at = line_end + 1;
+  }
+  bad_mesh_file(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }
 
 // A skipped `v` line gives the vertices after it the numbers before, so that faces join other

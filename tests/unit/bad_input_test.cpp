@@ -313,14 +313,26 @@ const std::vector<BadInput>& cases() {
       // Read as PLY for its content where assimp knows no reader for its extension.
       mesh("mesh_ply_truncated_header_unnamed", "{\"file\": \"m.dat\"}",
            "m.dat': its PLY header has no end_header line", "ply\nformat ascii 1.0\nelement vertex 3\nprop", "m.dat"),
-      // assimp 5.2 crashes on this header (a property line run into end_header), and takes a
-      // count as it stands: read in a child process, either is one line naming the file
-      // (tests/unit/child_read_test.cpp checks the lines a crash and the memory cap give).
-      mesh("mesh_ply_crashes_assimp", "{\"file\": \"m.ply\"}", "m.ply': ",
+      // assimp 5.2 crashes on this header (a property line run into end_header: no end_header
+      // line), or loops for ever on one whose end_header is misspelt or a comment's word; a crash
+      // in the child process that reads a mesh is one line too (tests/unit/child_read_test.cpp).
+      mesh("mesh_ply_end_header_run_into_a_property", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            ply_header("3", "1") + "list uchar int vertex_indicesxend_header\n" + std::string(36, '\0') + "\3" +
                std::string(12, '\0'),
            "m.ply"),
       // A count is checked against the bytes after the header before assimp takes it as it stands.
+      mesh("mesh_ply_end_header_misspelt", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
+           "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_headers\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+           "m.ply"),
+      mesh("mesh_ply_end_header_in_a_comment", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
+           "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\ncomment end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+           "m.ply"),
+      mesh("mesh_ply_no_body", "{\"file\": \"m.ply\"}",
+           "m.ply': its PLY header declares 3 vertex, 1 face elements, whose values take at least 19 bytes, where 0 follow",
+           "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header", "m.ply"),
       mesh("mesh_ply_count_huge", "{\"file\": \"m.ply\"}",
            "m.ply': its PLY header declares 4000000000 vertex, 1 face elements, whose values take at least "
            "12000000001 bytes, where 12 follow the header (a truncated or damaged file)",
