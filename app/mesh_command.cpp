@@ -50,6 +50,10 @@ void require_replaceable_mesh(const std::string& out, const MeshSpec& ms) {
   if (!ms.file.empty() && fs::equivalent(out, ms.file, ec))
     throw std::invalid_argument("--out '" + out + "' is the mesh file the model is filled from (model.file): name "
                                 "another file");
+  // (A pipe would block the reading of its start; the written mesh is renamed over what is there.)
+  if (!fs::is_regular_file(out, ec))
+    throw std::invalid_argument("--out '" + out + "' is not a regular file, which this would replace: remove it or "
+                                "name another file");
   if (!starts_as_gmsh_mesh(out))
     throw std::invalid_argument("--out '" + out + "' holds a file that is not a Gmsh mesh (it does not start with "
                                 "$MeshFormat or another section Gmsh reads as a mesh), which this would replace: "

@@ -2,6 +2,7 @@
 // run leaves (bad inputs: bad_input_test.cpp; experiments: cli_experiment_test.cpp; view and the
 // bench: cli_view_bench_test.cpp).
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -258,6 +259,19 @@ TEST_F(Cli, MeshNotesWhatARunOfTheSceneWouldRefuse) {
   EXPECT_TRUE(fs::is_regular_file(file));
   EXPECT_EQ(made.err, "deformlab: note: a run of this scene on the mesh would refuse it: " +
                           (dir_ / "s.json").string() + ".model.pins[0]: the box holds no node of the model\n");
+}
+
+// A pipe at --out is refused before anything is read from it (reading its start had blocked).
+TEST_F(Cli, MeshRefusesAPipeAtItsOut) {
+  write("s.json", R"({"model": {"type": "mesh", "pins": "none",
+                                "generate": {"shape": "sheet", "size": [0.2, 0.1], "cell_size": 0.05}}})");
+  const fs::path fifo = dir_ / "f.msh";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const Result r = run("mesh --scene " + (dir_ / "s.json").string() + " --out " + fifo.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "deformlab: error: --out '" + fifo.string() + "' is not a regular file, which this would replace: "
+                   "remove it or name another file\n");
+  EXPECT_TRUE(fs::is_fifo(fifo));
 }
 
 // The check places the written mesh as a run naming it would: a generated mesh still takes the
