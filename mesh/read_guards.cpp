@@ -37,6 +37,15 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
   // A keyword ends at a blank or the line's end ("v" alone is a vertex of no numbers).
   auto keyword = [&](char k) { return line[at] == k && (at + 1 == line.size() || blank(line[at + 1])); };
   if (at == line.size()) return;
+  // A vertex or face keyword in capitals, or a vertex's number run into its `v`.
+  const bool capital = (line[at] == 'V' || line[at] == 'F') && (at + 1 == line.size() || blank(line[at + 1]));
+  const bool run_in = (line[at] == 'v' || line[at] == 'V') && at + 1 < line.size() &&
+                      (std::isdigit(static_cast<unsigned char>(line[at + 1])) || line[at + 1] == '-' ||
+                       line[at + 1] == '+' || line[at + 1] == '.');
+  if (capital || run_in)
+    bad_line(path, number, std::string("a `") + (capital ? std::string(1, line[at]) : line.substr(at, 2) + "...") +
+                               "` line, which assimp's OBJ reader skips (" +
+                               (line[at] == 'F' ? "a face is `f a b c`" : "a vertex is `v x y z`") + ")");
   const bool vertex = keyword('v'), face = keyword('f');
   if (!vertex && !face) return;
   if (at > 0)

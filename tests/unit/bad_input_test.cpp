@@ -366,6 +366,15 @@ const std::vector<BadInput>& cases() {
            "m.obj': line 2: a vertex of 2 numbers, which assimp's OBJ reader skips (it keeps 3, 4 or 6, counting the "
            "words that start with a digit, + or -: write .5 as 0.5)",
            "v 0 0 0\nv .5 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),
+      mesh("mesh_obj_vertex_number_run_in", "{\"file\": \"m.obj\"}",
+           "m.obj': line 1: a `v5...` line, which assimp's OBJ reader skips (a vertex is `v x y z`)",
+           "v5 5 5\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n"),
+      mesh("mesh_obj_vertex_capital", "{\"file\": \"m.obj\"}",
+           "m.obj': line 1: a `V` line, which assimp's OBJ reader skips (a vertex is `v x y z`)",
+           "V 5 5 5\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n"),
+      mesh("mesh_obj_face_capital", "{\"file\": \"m.obj\"}",
+           "m.obj': line 5: a `F` line, which assimp's OBJ reader skips (a face is `f a b c`)",
+           "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\nF 1 3 2\n"),
       mesh("mesh_obj_vertex_continued", "{\"file\": \"m.obj\"}",
            "m.obj': line 2: a vertex of 2 numbers",  // "v 1\\" and "0 0" join as "v 10 0"
            "v 0 0 0\nv 1\\\n0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),
