@@ -23,8 +23,8 @@ void require_ply_header(const std::string& path, const Assimp::Importer& importe
 
 // A line of an OBJ file (read by assimp's OBJ reader) that the reader skips: a `v` line whose
 // words that it counts as numbers (those starting with a digit, '+', '-', "nan" or "inf") are not
-// 3, 4 or 6 (".5", a missing coordinate), or a `v` or `f` line that starts with a space, a tab or
-// (the first line) UTF-8's byte-order mark.
+// 3, 4 or 6 (".5", a missing coordinate), a `v` or `f` line that starts with a space, a tab or
+// (the first line) UTF-8's byte-order mark, or one written `V` or `F`, or `v5 0 0`.
 void require_obj_lines_read(const std::string& path);
 
 }  // namespace deformlab
