@@ -170,6 +170,24 @@ Model mesh_model_of(const ModelSpec& spec) {
   });
 }
 
+// Refuses a model that lies so far from the origin that float positions there are more than a
+// thousandth of its shortest spring apart: its strains and small moves would be lost to rounding
+// (a 16 x 16 cloth at 1e5 m never moved, and its run stopped as converged).
+void require_float_resolution(const Model& m) {
+  float far = 0.f;
+  for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  if (!m.grid() && m.rest_length.empty()) return;
+  // A grid's shortest spring is its structural one (the spacing).
+  const float shortest = m.grid() ? m.spacing : *std::min_element(m.rest_length.begin(), m.rest_length.end());
+  const float step = std::nextafter(far, INFINITY) - far;
+  if (step <= 1e-3f * shortest) return;
+  std::ostringstream os;
+  os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
+     << " m apart: more than a thousandth of its shortest spring (" << shortest
+     << " m), so rounding would swallow its strains and small moves: place it nearer the origin";
+  throw std::invalid_argument(os.str());
+}
+
 }  // namespace
 
 // Refused first when the model of the estimated size would not fit: springs and elements a node
@@ -214,9 +232,16 @@ Model build_model_in_file_order(const Scene& s) {
     // `width` spans the first axis with more than one node: x, unless the grid is one node wide.
     const int across = m.nx > 1 ? m.nx : m.ny > 1 ? m.ny : m.nz;
     const float h = m.spacing != 0.f ? m.spacing : across > 1 ? m.width / float(across - 1) : m.width;
+    if (h < float(kShortestLength)) {
+      std::ostringstream os;
+      os << "its width, " << m.width << " m across " << across << " nodes, spaces them " << std::setprecision(3) << h
+         << " m apart: under the 1e-6 m a model's lengths take";
+      throw std::invalid_argument(os.str());
+    }
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
   }
+  require_float_resolution(model);
   pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;
 }
