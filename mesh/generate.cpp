@@ -18,22 +18,28 @@ namespace {
 // line up along the seams, and Gmsh's order goes tile by tile).
 constexpr double kNodesPerTile = 5000;
 
-// The sheet as tiles x tiles plane surfaces of the built-in kernel, sharing points and lines.
+// The sheet as tx x tz plane surfaces of the built-in kernel, sharing points and lines: tiles as
+// near square as the sheet allows (a strip one tile across takes them all along its length; thin
+// tiles, narrower than a cell, made Gmsh place twice the nodes, slowly).
 void add_sheet(const MeshShape& s) {
   namespace geo = gmsh::model::geo;
-  const int t = std::max(1, int(std::ceil(std::sqrt(estimated_nodes(s) / kNodesPerTile))));
-  std::vector<int> point, along_x, along_z;  // at (i, k): i + k * (t + 1)
-  for (int k = 0; k <= t; ++k)
-    for (int i = 0; i <= t; ++i)
-      point.push_back(geo::addPoint(s.size.x * (double(i) / t - 0.5), 0, s.size.z * (double(k) / t - 0.5)));
-  auto at = [&](int i, int k) { return std::size_t(i + k * (t + 1)); };
-  for (int k = 0; k <= t; ++k)
-    for (int i = 0; i <= t; ++i) {
-      along_x.push_back(i < t ? geo::addLine(point[at(i, k)], point[at(i + 1, k)]) : 0);
-      along_z.push_back(k < t ? geo::addLine(point[at(i, k)], point[at(i, k + 1)]) : 0);
+  const double tiles = estimated_nodes(s) / kNodesPerTile, aspect = double(s.size.x) / double(s.size.z);
+  int tx = std::max(1, int(std::ceil(std::sqrt(tiles * aspect))));
+  int tz = std::max(1, int(std::ceil(std::sqrt(tiles / aspect))));
+  if (tz == 1) tx = std::max(1, int(std::ceil(tiles)));
+  if (tx == 1) tz = std::max(1, int(std::ceil(tiles)));
+  std::vector<int> point, along_x, along_z;  // at (i, k): i + k * (tx + 1)
+  for (int k = 0; k <= tz; ++k)
+    for (int i = 0; i <= tx; ++i)
+      point.push_back(geo::addPoint(s.size.x * (double(i) / tx - 0.5), 0, s.size.z * (double(k) / tz - 0.5)));
+  auto at = [&](int i, int k) { return std::size_t(i + k * (tx + 1)); };
+  for (int k = 0; k <= tz; ++k)
+    for (int i = 0; i <= tx; ++i) {
+      along_x.push_back(i < tx ? geo::addLine(point[at(i, k)], point[at(i + 1, k)]) : 0);
+      along_z.push_back(k < tz ? geo::addLine(point[at(i, k)], point[at(i, k + 1)]) : 0);
     }
-  for (int k = 0; k < t; ++k)
-    for (int i = 0; i < t; ++i)
+  for (int k = 0; k < tz; ++k)
+    for (int i = 0; i < tx; ++i)
       geo::addPlaneSurface({geo::addCurveLoop(
           {along_x[at(i, k)], along_z[at(i + 1, k)], -along_x[at(i, k + 1)], -along_z[at(i, k)]})});
   geo::synchronize();

@@ -149,6 +149,26 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
   });
 }
 
+// Refuses a model that lies so far from the origin that float positions there are more than a
+// hundredth of its shortest spring apart: its strains and small moves would be lost to rounding
+// (a 16 x 16 cloth at 1e5 m never moved, and its run stopped as converged; at 1e4 m it jittered
+// to max_steps). A 16384^2 cloth 1 m wide at 1 m, the paper's largest, has floats 0.2% of a spring
+// apart.
+void require_float_resolution(const Model& m) {
+  float far = 0.f;
+  for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  if (!m.grid() && m.rest_length.empty()) return;
+  // A grid's shortest spring is its structural one (the spacing).
+  const float shortest = m.grid() ? m.spacing : *std::min_element(m.rest_length.begin(), m.rest_length.end());
+  const float step = std::nextafter(far, INFINITY) - far;
+  if (step <= 1e-2f * shortest) return;
+  std::ostringstream os;
+  os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
+     << " m apart: more than a hundredth of its shortest spring (" << shortest
+     << " m), so rounding would swallow its strains and small moves: place it nearer the origin";
+  throw std::invalid_argument(os.str());
+}
+
 Model mesh_model_of(const ModelSpec& spec) {
   std::vector<std::string> notes;
   std::string what;
@@ -165,28 +185,12 @@ Model mesh_model_of(const ModelSpec& spec) {
          << "other units: its \"scale\")";
       throw std::invalid_argument(os.str());
     }
+    require_float_resolution(m);
     m.repairs = std::move(notes);
     return m;
   });
 }
 
-// Refuses a model that lies so far from the origin that float positions there are more than a
-// thousandth of its shortest spring apart: its strains and small moves would be lost to rounding
-// (a 16 x 16 cloth at 1e5 m never moved, and its run stopped as converged).
-void require_float_resolution(const Model& m) {
-  float far = 0.f;
-  for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-  if (!m.grid() && m.rest_length.empty()) return;
-  // A grid's shortest spring is its structural one (the spacing).
-  const float shortest = m.grid() ? m.spacing : *std::min_element(m.rest_length.begin(), m.rest_length.end());
-  const float step = std::nextafter(far, INFINITY) - far;
-  if (step <= 1e-3f * shortest) return;
-  std::ostringstream os;
-  os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
-     << " m apart: more than a thousandth of its shortest spring (" << shortest
-     << " m), so rounding would swallow its strains and small moves: place it nearer the origin";
-  throw std::invalid_argument(os.str());
-}
 
 }  // namespace
 
@@ -240,8 +244,8 @@ Model build_model_in_file_order(const Scene& s) {
     }
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
+    require_float_resolution(model);
   }
-  require_float_resolution(model);
   pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;
 }

@@ -295,14 +295,14 @@ const std::vector<BadInput>& cases() {
       scene("grid_spacing_from_width_too_short", R"({"model": {"size": [1001, 11], "width": 1e-6}})",
             "s.json.model (cloth 1001x11): its width, 1e-06 m across 1001 nodes, spaces them 1e-09 m apart: under the "
             "1e-6 m a model's lengths take"),
-      // Floats 0.0078 m apart at 1e5 m, over a thousandth of the 0.0667 m springs: the cloth never moved.
+      // Floats 0.0078 m apart at 1e5 m, over a hundredth of the 0.0667 m springs: the cloth never moved.
       scene("grid_far_from_the_origin", R"({"model": {"size": [16, 16], "height": 1e5}})",
             "s.json.model (cloth 16x16): it lies up to 1e+05 m from the origin, where floats are 0.00781 m apart: more "
-            "than a thousandth of its shortest spring (0.0667 m), so rounding would swallow its strains and small moves: "
+            "than a hundredth of its shortest spring (0.0667 m), so rounding would swallow its strains and small moves: "
             "place it nearer the origin"),
-      mesh("mesh_far_from_the_origin", "{\"file\": \"m.obj\", \"transform\": {\"translate\": [0, 0, 3000]}}",
-           "it lies up to 3e+03 m from the origin, where floats are 0.000244 m apart: more than a thousandth of its "
-           "shortest spring (0.1 m)", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"),
+      mesh("mesh_far_from_the_origin", "{\"file\": \"m.obj\", \"transform\": {\"translate\": [0, 0, 30000]}}",
+           "m.obj': it lies up to 3e+04 m from the origin, where floats are 0.00195 m apart: more than a hundredth of "
+           "its shortest spring (0.1 m)", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"),
       scene("grid_spacing_past_float", "{\"model\": {\"size\": [4, 4], \"spacing\": 2e38}}",
             "s.json.model.spacing: expected a length within [1e-6, 1e6] m"),
       scene("grid_height_far", "{\"model\": {\"size\": [4, 4], \"height\": -1e7}}",

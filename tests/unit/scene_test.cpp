@@ -168,6 +168,18 @@ TEST(Scene, AGeneratedMeshTakesFillNone) {
   EXPECT_TRUE(s.model.mesh.generate.has_value());
 }
 
+// The paper's largest cloth (16384 nodes across 1 m, at 1 m) keeps floats within a hundredth of
+// its spacing (0.2%): built here as a strip of that spacing. Lifted to 1e4 m it is refused.
+TEST(Scene, FloatsResolveThePapersLargestClothButNotOneFarAway) {
+  Scene s = default_experiment().scene;
+  s.model.nx = 16384;
+  s.model.ny = 2;
+  s.model.pins = PinSet::none;
+  EXPECT_NO_THROW(build_model(s));
+  s.model.height = 1e4f;
+  EXPECT_THROW(build_model(s), std::invalid_argument);
+}
+
 // A JSON file is read up to its cap whatever its size says: one of the cap's bytes is read, one
 // byte more is refused.
 TEST(Scene, AJsonFileOverTheCapIsRefused) {
