@@ -3,6 +3,8 @@
 // same mesh.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -23,19 +25,22 @@ using nlohmann::json;
 
 MeshShape shape(MeshShape::Kind k, Vec3f size, float h) { return {k, size, h}; }
 
+// One tile, 5 x 3 tiles, and a strip of 21 tiles along its length.
 TEST(GeneratedMesh, SheetHasTheEstimatedNodesAndTwoTrianglesANode) {
-  const MeshShape s = shape(MeshShape::Kind::sheet, {0.5f, 0.f, 0.3f}, 0.01f);
-  Mesh m = generate_shape(s);
-  const double n = double(m.position.size());
-  EXPECT_NEAR(n, estimated_nodes(s), 0.1 * estimated_nodes(s));
-  EXPECT_FALSE(m.volume());
-  EXPECT_NEAR(double(m.triangle.size()) / n, 2.0, 0.1);  // Euler: t = 2n - boundary nodes - 2
-  for (const auto& p : m.position) {
-    EXPECT_EQ(p.y, 0.f);
-    EXPECT_LE(std::abs(p.x), 0.25f + 1e-6f);
-    EXPECT_LE(std::abs(p.z), 0.15f + 1e-6f);
+  for (const auto& [x, z, h] : {std::tuple{0.5f, 0.3f, 0.01f}, {0.5f, 0.3f, 0.002f}, {4.f, 0.02f, 0.001f}}) {
+    const MeshShape s = shape(MeshShape::Kind::sheet, {x, 0.f, z}, h);
+    Mesh m = generate_shape(s);
+    const double n = double(m.position.size());
+    EXPECT_NEAR(n, estimated_nodes(s), 0.1 * estimated_nodes(s)) << x << " x " << z;
+    EXPECT_FALSE(m.volume());
+    EXPECT_NEAR(double(m.triangle.size()) / n, 2.0, 0.1);  // Euler: t = 2n - boundary nodes - 2
+    for (const auto& p : m.position) {
+      EXPECT_EQ(p.y, 0.f);
+      EXPECT_LE(std::abs(p.x), x / 2 + 1e-6f);
+      EXPECT_LE(std::abs(p.z), z / 2 + 1e-6f);
+    }
+    EXPECT_TRUE(repair(m).empty()) << x << " x " << z;  // nothing to weld or drop: one conforming mesh over the tiles
   }
-  EXPECT_TRUE(repair(m).empty());  // nothing to weld or drop: one conforming mesh over the tiles
 }
 
 TEST(GeneratedMesh, BoxIsAClosedManifoldVolume) {
