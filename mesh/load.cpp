@@ -385,7 +385,15 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
     GmshSession gmsh;
     Mesh m;
     GmshSession::run(what, [&] {
-      gmsh::open(path);
+      try {
+        gmsh::open(path);
+      } catch (...) {
+        std::string error;  // Gmsh's MSH 2 reader says no more than this of what it could not read:
+        if (gmsh::logger::getLastError(error), error.starts_with("Error loading"))
+          bad_mesh_file(path, "Gmsh could not read it (" + error + "): a file cut short, a count that its data "
+                              "disagrees with, or a damaged section");
+        throw;
+      }
       m = read_gmsh_model(what, &read_notes);
     });
     return m;

@@ -316,6 +316,10 @@ const std::vector<BadInput>& cases() {
            "m.msh': not a Gmsh mesh: it does not start with $MeshFormat or another section Gmsh reads as a mesh (Gmsh "
            "would read it as a .geo script)",
            "hello world\n", "m.msh"),
+      mesh("mesh_msh2_cut_short", "{\"file\": \"m.msh\"}",
+           "m.msh': Gmsh could not read it (Error loading '",
+           "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+           "$Elements\n1 4 2 0 1 1 2 3 4\n", "m.msh"),
       mesh("mesh_ply_truncated_header", "{\"file\": \"m.ply\"}", "m.ply': its PLY header has no end_header line",
            "ply\nformat ascii 1.0\n", "m.ply"),
       // assimp clamps an OFF face's index out of range and says so only in its log.
