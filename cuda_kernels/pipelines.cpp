@@ -24,7 +24,8 @@ Tile parse_tile(const std::string& s) {
   const auto w = option_count(std::string_view(s).substr(0, x), 1024);
   const auto h = x == std::string::npos ? std::nullopt : option_count(std::string_view(s).substr(x + 1), 1024);
   if (!w || !h || *w * *h > 1024)
-    throw std::invalid_argument("CUDA tile '" + s + "' is not WxH with 1..1024 threads, in plain digits (e.g. 32x8)");
+    throw std::invalid_argument("CUDA tile '" + s +
+                                "' is not WxH with 1..1024 threads, in plain digits with no leading zero (e.g. 32x8)");
   return {int(*w), int(*h)};
 }
 
@@ -57,7 +58,7 @@ TemporalTile parse_temporal_tile(const std::string& s) {
   }
   if (n < 2 || at <= s.size())
     throw std::invalid_argument("cuda-temporal tile '" + s +
-                                "' is not WxH or WxHxD nodes, in plain digits (e.g. 40x40)");
+                                "' is not WxH or WxHxD nodes, in plain digits with no leading zero (e.g. 40x40)");
   return t;
 }
 

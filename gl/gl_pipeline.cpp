@@ -84,7 +84,7 @@ void read_options(const PipelineOptions& o) {
   for (const char* name : {"window", "link_view"})
     if (const auto it = o.find(name); it != o.end() && !option_count(it->second, INT64_MAX))
       throw std::invalid_argument(std::string("option ") + name + " '" + it->second +
-                                  "' is not a count of 1 or more (plain digits)");
+                                  "' is not a count of 1 or more (plain digits, no leading zero)");
 }
 
 std::string idle_option(const PipelineOptions& o, Topology t) {
@@ -170,7 +170,7 @@ std::int64_t GlPipeline::count_option(const PipelineOptions& o, const std::strin
   const auto v = option_count(it->second, most);
   if (!v)
     throw std::invalid_argument(name_ + ": option " + name + " '" + it->second + "' is not a count from 1 to " +
-                                std::to_string(most) + " (" + limit + "; plain digits)");
+                                std::to_string(most) + " (" + limit + "; plain digits, no leading zero)");
   return *v;
 }
 
