@@ -67,7 +67,7 @@ int steps_per_launch_option(const PipelineOptions& o) {
   if (it == o.end()) return 0;
   if (const auto k = option_count(it->second, 8)) return int(*k);
   throw std::invalid_argument("option steps_per_launch '" + it->second +
-                              "' is not a count from 1 to 8 (plain digits)");
+                              "' is not a count from 1 to 8 (plain digits, no leading zero)");
 }
 
 int steps_per_launch(const Options& o) { return o.steps_per_launch > 0 ? o.steps_per_launch : 2; }

@@ -387,8 +387,10 @@ Mesh load_mesh(const std::string& path, std::vector<std::string>& notes) {
     GmshSession::run(what, [&] {
       try {
         gmsh::open(path);
+      } catch (const std::bad_alloc&) {
+        throw;
       } catch (...) {
-        std::string error;  // Gmsh's MSH 2 reader says no more than this of what it could not read:
+        std::string error;  // Gmsh says no more than this of a file it could not read (MSH 2):
         if (gmsh::logger::getLastError(error), error.starts_with("Error loading"))
           bad_mesh_file(path, "Gmsh could not read it (" + error + "): a file cut short, a count that its data "
                               "disagrees with, or a damaged section");

@@ -2,6 +2,7 @@
 
 #include <assimp/Importer.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
@@ -37,15 +38,18 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
   // A keyword ends at a blank or the line's end ("v" alone is a vertex of no numbers).
   auto keyword = [&](char k) { return line[at] == k && (at + 1 == line.size() || blank(line[at + 1])); };
   if (at == line.size()) return;
-  // A vertex or face keyword in capitals, or a vertex's number run into its `v`.
+  // A vertex or face keyword in capitals, or its first number run into it.
+  const bool v_or_f = line[at] == 'v' || line[at] == 'V' || line[at] == 'f' || line[at] == 'F';
   const bool capital = (line[at] == 'V' || line[at] == 'F') && (at + 1 == line.size() || blank(line[at + 1]));
-  const bool run_in = (line[at] == 'v' || line[at] == 'V') && at + 1 < line.size() &&
+  const bool run_in = v_or_f && at + 1 < line.size() &&
                       (std::isdigit(static_cast<unsigned char>(line[at + 1])) || line[at + 1] == '-' ||
                        line[at + 1] == '+' || line[at + 1] == '.');
   if (capital || run_in)
     bad_line(path, number, std::string("a `") + (capital ? std::string(1, line[at]) : line.substr(at, 2) + "...") +
-                               "` line, which assimp's OBJ reader skips (" +
-                               (line[at] == 'F' ? "a face is `f a b c`" : "a vertex is `v x y z`") + ")");
+                               "` line, which assimp's OBJ reader " +
+                               (line[at] == 'f' ? "reads without its first index" : "skips") + " (" +
+                               (line[at] == 'F' || line[at] == 'f' ? "a face is `f a b c`" : "a vertex is `v x y z`") +
+                               ")");
   const bool vertex = keyword('v'), face = keyword('f');
   if (!vertex && !face) return;
   if (at > 0)
@@ -67,7 +71,9 @@ void check_obj_line(const std::string& path, const std::string& line, std::int64
 // its CPU cap on it (a minute on 10^8 promised vertices). A count is read as assimp reads it:
 // its leading digits, in 32 bits (wrapping).
 void require_ply_counts_fit(const std::string& path, const std::string& header, std::uintmax_t body_bytes) {
-  std::istringstream lines(header);
+  std::string text = header;  // lines end at "\n", "\r\n" or "\r", as assimp reads them
+  std::replace(text.begin(), text.end(), '\r', '\n');
+  std::istringstream lines(text);
   bool ascii = false;
   std::uint32_t count = 0;  // of the element whose properties follow
   std::uint64_t need = 0;   // bytes: at most 2 (2^32 - 1) a property line, exact in 64 bits
@@ -117,17 +123,17 @@ void require_ply_header(const std::string& path, const Assimp::Importer& importe
   const bool magic = head.starts_with("ply") || head.starts_with("PLY");
   const bool ply = ext == ".ply" || (!importer.IsExtensionSupported(ext) && magic);
   if (!ply) return;
-  for (std::size_t at = 0; at < head.size();) {
-    const std::size_t line_end = std::min(head.find('\n', at), head.size());
+  for (std::size_t at = 0; at < head.size();) {  // lines end at "\n", "\r\n" or "\r"
+    const std::size_t line_end = std::min(head.find_first_of("\r\n", at), head.size());
+    const std::size_t next = std::min(line_end + (head.compare(line_end, 2, "\r\n") == 0 ? 2 : 1), head.size());
     std::istringstream words(head.substr(at, line_end - at));
     if (std::string first; words >> first && first == "end_header") {
       std::error_code ec;
       const std::uintmax_t size = std::filesystem::file_size(path, ec);
-      const std::size_t body = std::min(line_end + 1, head.size());
-      if (!ec) require_ply_counts_fit(path, head.substr(0, at), size - body);
+      if (!ec) require_ply_counts_fit(path, head.substr(0, at), size - next);
       return;
     }
-    at = line_end + 1;
+    at = next;
   }
   bad_mesh_file(path, "its PLY header has no end_header line in its first 64 KiB (a truncated or damaged file)");
 }

@@ -159,13 +159,16 @@ void require_float_resolution(const Model& m) {
   for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   if (!m.grid() && m.rest_length.empty()) return;
   // A grid's shortest spring is its structural one (the spacing).
-  const float shortest = m.grid() ? m.spacing : *std::min_element(m.rest_length.begin(), m.rest_length.end());
+  const auto s = m.grid() ? 0 : std::min_element(m.rest_length.begin(), m.rest_length.end()) - m.rest_length.begin();
+  const float shortest = m.grid() ? m.spacing : m.rest_length[std::size_t(s)];
   const float step = std::nextafter(far, INFINITY) - far;
   if (step <= 1e-2f * shortest) return;
   std::ostringstream os;
   os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
-     << " m apart: more than a hundredth of its shortest spring (" << shortest
-     << " m), so rounding would swallow its strains and small moves: place it nearer the origin";
+     << " m apart: more than a hundredth of its shortest spring (" << shortest << " m";
+  if (!m.grid()) os << ", between nodes " << m.file_index(m.spring_i[s]) << " and " << m.file_index(m.spring_j[s]);
+  os << "), so rounding would swallow its strains and small moves: place it nearer the origin, or make that spring "
+        "longer";
   throw std::invalid_argument(os.str());
 }
 

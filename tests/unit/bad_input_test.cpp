@@ -299,10 +299,10 @@ const std::vector<BadInput>& cases() {
       scene("grid_far_from_the_origin", R"({"model": {"size": [16, 16], "height": 1e5}})",
             "s.json.model (cloth 16x16): it lies up to 1e+05 m from the origin, where floats are 0.00781 m apart: more "
             "than a hundredth of its shortest spring (0.0667 m), so rounding would swallow its strains and small moves: "
-            "place it nearer the origin"),
+            "place it nearer the origin, or make that spring longer"),
       mesh("mesh_far_from_the_origin", "{\"file\": \"m.obj\", \"transform\": {\"translate\": [0, 0, 30000]}}",
            "m.obj': it lies up to 3e+04 m from the origin, where floats are 0.00195 m apart: more than a hundredth of "
-           "its shortest spring (0.1 m)", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"),
+           "its shortest spring (0.1 m, between nodes 0 and 1)", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"),
       scene("grid_spacing_past_float", "{\"model\": {\"size\": [4, 4], \"spacing\": 2e38}}",
             "s.json.model.spacing: expected a length within [1e-6, 1e6] m"),
       scene("grid_height_far", "{\"model\": {\"size\": [4, 4], \"height\": -1e7}}",
@@ -390,6 +390,16 @@ const std::vector<BadInput>& cases() {
       mesh("mesh_obj_face_capital", "{\"file\": \"m.obj\"}",
            "m.obj': line 5: a `F` line, which assimp's OBJ reader skips (a face is `f a b c`)",
            "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\nF 1 3 2\n"),
+      mesh("mesh_obj_face_index_run_in", "{\"file\": \"m.obj\"}",
+           "m.obj': line 5: a `f2...` line, which assimp's OBJ reader reads without its first index (a face is `f a b c`)",
+           "v 0 0 0\nv 1 0 0\nv 0 0 1\nv 1 0 1\nf2 4 3 1\n"),
+      // Lines that end in a lone CR, as assimp reads them.
+      mesh("mesh_ply_cr_line_ends", "{\"file\": \"m.ply\"}",
+           "m.ply': its PLY header declares 30 vertex, 1 face elements, whose values take at least 181 bytes, where 26 "
+           "follow the header",
+           "ply\rformat ascii 1.0\relement vertex 30\rproperty float x\rproperty float y\rproperty float z\r"
+           "element face 1\rproperty list uchar int vertex_indices\rend_header\r0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r",
+           "m.ply"),
       mesh("mesh_obj_vertex_continued", "{\"file\": \"m.obj\"}",
            "m.obj': line 2: a vertex of 2 numbers",  // "v 1\\" and "0 0" join as "v 10 0"
            "v 0 0 0\nv 1\\\n0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n"),

@@ -112,6 +112,15 @@ TEST_F(MeshFile, PlyCountsAreCheckedAgainstTheLeastBytesTheyTake) {
   }
 }
 
+// Lines that end in a lone CR, which assimp reads as line ends, end the header's lines too.
+TEST_F(MeshFile, APlyOfCrLineEndsIsRead) {
+  Mesh m = load(write("cr.ply", "ply\rformat ascii 1.0\relement vertex 3\rproperty float x\rproperty float y\r"
+                                "property float z\relement face 1\rproperty list uchar int vertex_indices\r"
+                                "end_header\r0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r"));
+  EXPECT_EQ(m.position.size(), 3u);
+  EXPECT_EQ(m.triangle.size(), 1u);
+}
+
 // Gmsh takes a file that starts with $Comments as a mesh too.
 TEST_F(MeshFile, AMshFileMayStartWithComments) {
   Mesh m = load(write("c.msh", "$Comments\nfrom a mesher\n$EndComments\n$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"

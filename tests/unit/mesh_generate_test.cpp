@@ -25,7 +25,7 @@ using nlohmann::json;
 
 MeshShape shape(MeshShape::Kind k, Vec3f size, float h) { return {k, size, h}; }
 
-// One tile, 5 x 3 tiles, and a strip of 21 tiles along its length.
+// One tile, 5 x 3 tiles, and a strip one tile across with its tiles along its length.
 TEST(GeneratedMesh, SheetHasTheEstimatedNodesAndTwoTrianglesANode) {
   for (const auto& [x, z, h] : {std::tuple{0.5f, 0.3f, 0.01f}, {0.5f, 0.3f, 0.002f}, {4.f, 0.02f, 0.001f}}) {
     const MeshShape s = shape(MeshShape::Kind::sheet, {x, 0.f, z}, h);
