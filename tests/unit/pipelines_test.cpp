@@ -188,6 +188,14 @@ TEST(Pipelines, OptionsAreReadBeforeAnythingRuns) {
       EXPECT_TRUE(refusal(name, o).starts_with(std::string(name) + ": ")) << name;
     }
   }
+  // A count with a leading zero is told so (it is refused to keep one spelling of each value).
+  for (const auto& [name, o] : std::vector<std::pair<const char*, PipelineOptions>>{
+           {"glsl-compute", {{"window", "064"}}}, {"cuda-fused", {{"tile", "32x08"}}},
+           {"cuda-temporal", {{"steps_per_launch", "02"}}}, {"cuda-temporal", {{"tile", "040x40"}}}}) {
+    if (r.find(name)->read_options) {
+      EXPECT_NE(refusal(name, o).find("no leading zero"), std::string::npos) << refusal(name, o);
+    }
+  }
   for (const char* name : {"cuda-temporal", "glsl-compute"}) {
     if (r.find(name)->read_options) {
       EXPECT_EQ(refusal(name, {{"math", "exact"}}), "") << name;
