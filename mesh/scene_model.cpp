@@ -150,24 +150,19 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
 }
 
 // Refuses a model that lies so far from the origin that float positions there are more than a
-// hundredth of its shortest spring apart: its strains and small moves would be lost to rounding
-// (a 16 x 16 cloth at 1e5 m never moved, and its run stopped as converged; at 1e4 m it jittered
-// to max_steps). A 16384^2 cloth 1 m wide at 1 m, the paper's largest, has floats 0.2% of a spring
-// apart.
-void require_float_resolution(const Model& m) {
+// hundredth of its shortest spring (`shortest` m long; `which` names it) apart: its strains and
+// small moves would be lost to rounding (a 16 x 16 cloth at 1e5 m never moved, and its run
+// stopped as converged; at 1e4 m it jittered to max_steps). A 16384^2 cloth 1 m wide at 1 m, the
+// paper's largest, has floats 0.2% of a spring apart.
+void require_float_resolution(const Model& m, float shortest, const std::string& which) {
   float far = 0.f;
   for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-  if (!m.grid() && m.rest_length.empty()) return;
-  // A grid's shortest spring is its structural one (the spacing).
-  const auto s = m.grid() ? 0 : std::min_element(m.rest_length.begin(), m.rest_length.end()) - m.rest_length.begin();
-  const float shortest = m.grid() ? m.spacing : m.rest_length[std::size_t(s)];
   const float step = std::nextafter(far, INFINITY) - far;
   if (step <= 1e-2f * shortest) return;
   std::ostringstream os;
   os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
-     << " m apart: more than a hundredth of its shortest spring (" << shortest << " m";
-  if (!m.grid()) os << ", between nodes " << m.file_index(m.spring_i[s]) << " and " << m.file_index(m.spring_j[s]);
-  os << "), so rounding would swallow its strains and small moves: place it nearer the origin, or make that spring "
+     << " m apart: more than a hundredth of its shortest spring (" << shortest << " m" << which
+     << "), so rounding would swallow its strains and small moves: place it nearer the origin, or make that spring "
         "longer";
   throw std::invalid_argument(os.str());
 }
@@ -180,15 +175,18 @@ Model mesh_model_of(const ModelSpec& spec) {
     check_memory(mesh);
     Model m = mesh_model(mesh, spec.material, spec.mesh.density);
     const auto shortest = std::min_element(m.rest_length.begin(), m.rest_length.end());
-    if (shortest != m.rest_length.end() && *shortest < float(kShortestLength)) {
+    if (shortest != m.rest_length.end()) {
       const auto s = shortest - m.rest_length.begin();
-      std::ostringstream os;
-      os << "the spring between nodes " << m.file_index(m.spring_i[s]) << " and " << m.file_index(m.spring_j[s]) << " is "
-         << std::setprecision(3) << *shortest << " m long, shorter than the 1e-6 m a model's lengths take (a mesh in "
-         << "other units: its \"scale\")";
-      throw std::invalid_argument(os.str());
+      const std::string nodes = "between nodes " + std::to_string(m.file_index(m.spring_i[s])) + " and " +
+                                std::to_string(m.file_index(m.spring_j[s]));
+      if (*shortest < float(kShortestLength)) {
+        std::ostringstream os;
+        os << "the spring " << nodes << " is " << std::setprecision(3) << *shortest
+           << " m long, shorter than the 1e-6 m a model's lengths take (a mesh in other units: its \"scale\")";
+        throw std::invalid_argument(os.str());
+      }
+      require_float_resolution(m, *shortest, ", " + nodes);
     }
-    require_float_resolution(m);
     m.repairs = std::move(notes);
     return m;
   });
@@ -247,7 +245,7 @@ Model build_model_in_file_order(const Scene& s) {
     }
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
-    require_float_resolution(model);
+    require_float_resolution(model, h, "");  // a grid's shortest spring: its structural one
   }
   pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;
