@@ -239,9 +239,9 @@ void require_size_scenes(const Experiment& x, const Sweep& s) {
   for (const int n : s.sizes) {
     Scene scene = x.scene;
     size_model(scene.model, n);
-    if (model_size(scene.model).nodes > kCheckedNodes) continue;
     try {
-      resolve_params(scene, build_model(scene));
+      if (scene.model.topology != Topology::general) grid_spacing(scene.model);  // any size: built from the spec
+      if (model_size(scene.model).nodes <= kCheckedNodes) resolve_params(scene, build_model(scene));
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(size_key(s, n) + ": " + e.what());
     }

@@ -64,8 +64,9 @@ void size_model(ModelSpec& ms, int n);
 
 std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::string& where);
 // Throws std::invalid_argument naming the first grid size on which the experiment's scene is bad
-// input (a pin or drag node outside or on each other, a node deep in a collider: resolve_params),
-// checked before the first cell on every size of up to kCheckedNodes nodes (built for it).
+// input, before the first cell: on every size its spacing and float resolution (grid_spacing), and
+// on every size of up to kCheckedNodes nodes (built for it) its pins, drag node and colliders
+// (a pin or drag node outside or on each other, a node deep in a collider: resolve_params).
 constexpr std::int64_t kCheckedNodes = std::int64_t(1) << 22;
 void require_size_scenes(const Experiment& x, const Sweep& s);
 // The key path of a grid size, for errors: "x.json.sweep.sizes[k]: size 64²".
@@ -125,7 +126,8 @@ class ModelCache {
 // "nodes", "springs", "model_build_s" (0: a model built for an earlier cell) and, for mesh
 // models, "model", "order", "mesh" ("surface" or "volume") and "bandwidth". Throws
 // std::invalid_argument where the cell's model or scene is bad input (a model generated or
-// filled, or a grid over kCheckedNodes, is built and checked only here): the sweep stops.
+// filled, or the pins, drag node and colliders of a grid over kCheckedNodes, are checked only
+// here): the sweep stops.
 nlohmann::json run_cell(const Experiment& x, const Sweep& s, const Cell& c, ModelCache& cache);
 
 // Frames of the experiment's own scene (its model, not a sweep size) on the best pipeline

@@ -149,14 +149,12 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
   });
 }
 
-// Refuses a model that lies so far from the origin that float positions there are more than a
-// hundredth of its shortest spring (`shortest` m long; `which` names it) apart: its strains and
-// small moves would be lost to rounding (a 16 x 16 cloth at 1e5 m never moved, and its run
-// stopped as converged; at 1e4 m it jittered to max_steps). A 16384^2 cloth 1 m wide at 1 m, the
-// paper's largest, has floats 0.2% of a spring apart.
-void require_float_resolution(const Model& m, float shortest, const std::string& which) {
-  float far = 0.f;
-  for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+// Refuses a model whose nodes reach `far` m from the origin along an axis, where float positions
+// are more than a hundredth of its shortest spring (`shortest` m long; `which` names it) apart:
+// its strains and small moves would be lost to rounding (a 16 x 16 cloth at 1e5 m never moved,
+// and its run stopped as converged; at 1e4 m it jittered to max_steps). A 16384^2 cloth 1 m wide
+// at 1 m, the paper's largest, has floats 0.2% of a spring apart.
+void require_float_resolution(float far, float shortest, const std::string& which) {
   const float step = std::nextafter(far, INFINITY) - far;
   if (step <= 1e-2f * shortest) return;
   std::ostringstream os;
@@ -185,7 +183,9 @@ Model mesh_model_of(const ModelSpec& spec) {
            << " m long, shorter than the 1e-6 m a model's lengths take (a mesh in other units: its \"scale\")";
         throw std::invalid_argument(os.str());
       }
-      require_float_resolution(m, *shortest, ", " + nodes);
+      float far = 0.f;
+      for (const Vec3f& p : m.rest_position) far = std::max({far, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+      require_float_resolution(far, *shortest, ", " + nodes);
     }
     m.repairs = std::move(notes);
     return m;
@@ -227,25 +227,34 @@ Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to) {
   return model_mesh(ms, notes, what, save_to);
 }
 
+float grid_spacing(const ModelSpec& m) {
+  if (m.nx < 1 || m.ny < 1 || m.nz < 1) throw std::invalid_argument("model size must be positive in every dimension");
+  // `width` spans the first axis with more than one node: x, unless the grid is one node wide.
+  const int across = m.nx > 1 ? m.nx : m.ny > 1 ? m.ny : m.nz;
+  const float h = m.spacing != 0.f ? m.spacing : across > 1 ? m.width / float(across - 1) : m.width;
+  if (h < float(kShortestLength)) {
+    std::ostringstream os;
+    os << "its width, " << m.width << " m across " << across << " nodes, spaces them " << std::setprecision(3) << h
+       << " m apart: under the 1e-6 m a model's lengths take";
+    throw std::invalid_argument(os.str());
+  }
+  // The farthest coordinate as cloth_grid and lattice place the nodes (centred in x and z, from
+  // `height` up in y), to the bit; the shortest spring is the structural one, h.
+  const float cx = 0.5f * float(m.nx - 1) * h, cz = 0.5f * float((m.topology == Topology::lattice ? m.nz : m.ny) - 1) * h;
+  const float top = m.topology == Topology::lattice ? m.height + float(m.ny - 1) * h : m.height;
+  require_float_resolution(std::max({cx, cz, std::abs(m.height), std::abs(top)}), h, "");
+  return h;
+}
+
 Model build_model_in_file_order(const Scene& s) {
   const ModelSpec& m = s.model;
   Model model;
   if (m.topology == Topology::general) {
     model = mesh_model_of(m);
   } else {
-    if (m.nx < 1 || m.ny < 1 || m.nz < 1) throw std::invalid_argument("model size must be positive in every dimension");
-    // `width` spans the first axis with more than one node: x, unless the grid is one node wide.
-    const int across = m.nx > 1 ? m.nx : m.ny > 1 ? m.ny : m.nz;
-    const float h = m.spacing != 0.f ? m.spacing : across > 1 ? m.width / float(across - 1) : m.width;
-    if (h < float(kShortestLength)) {
-      std::ostringstream os;
-      os << "its width, " << m.width << " m across " << across << " nodes, spaces them " << std::setprecision(3) << h
-         << " m apart: under the 1e-6 m a model's lengths take";
-      throw std::invalid_argument(os.str());
-    }
+    const float h = grid_spacing(m);
     model = m.topology == Topology::lattice ? lattice(m.nx, m.ny, m.nz, h, m.height, m.material)
                                             : cloth_grid(m.nx, m.ny, h, m.height, m.material);
-    require_float_resolution(model, h, "");  // a grid's shortest spring: its structural one
   }
   pin(model, pin_nodes(model, m.pins, m.pin_list, m.pins_where));  // before reordering: indices are the file's
   return model;

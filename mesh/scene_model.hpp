@@ -30,6 +30,12 @@ Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
 // naming it.
 void check_mesh_file(const Scene& s);
 
+// The spacing of a grid or lattice model (from its width where it has none), computed without
+// building it; throws std::invalid_argument where the grid cannot be built as its nodes' floats
+// need: a size under 1, a spacing under 1e-6 m, or nodes so far from the origin that float
+// positions there are more than a hundredth of the spacing apart.
+float grid_spacing(const ModelSpec& m);
+
 // build_model in two parts, for callers that keep one mesh in several orders: the model with
 // its pins in the file's order (a generated mesh: Gmsh's), then the scene's node order.
 Model build_model_in_file_order(const Scene& s);

@@ -448,6 +448,11 @@ const std::vector<BadInput>& cases() {
       {"sweep_size_drag_node_outside", "experiment {dir}/x.json",
        "x.json.sweep.sizes[1]: size 4²: ",
        {{"x.json", R"({"base": "quick", "scene": {"drag": {"node": 20}}, "sweep": {"sizes": [8, 4], "pipelines": ["cpu"]}})"}}},
+      // 4096² is over kCheckedNodes and never built here: its spacing (1 m / 4095) at 40 m is checked from the spec.
+      {"sweep_size_float_resolution", "experiment {dir}/x.json",
+       "x.json.sweep.sizes[1]: size 4096²: it lies up to 40 m from the origin, where floats are 3.81e-06 m apart: more "
+       "than a hundredth of its shortest spring (0.000244 m)",
+       {{"x.json", R"({"base": "quick", "scene": {"model": {"height": 40}}, "sweep": {"sizes": [8, 4096], "pipelines": ["cpu"]}})"}}},
       {"sweep_size_drag_node_pinned", "experiment {dir}/x.json",
        "x.json.sweep.sizes[0]: size 1²: built-in paper-drag.json.scene.drag.node: node 0 is pinned (model.pins)",
        {{"x.json", R"({"base": "quick", "sweep": {"sizes": [1, 8], "pipelines": ["cpu"]}})"}}},
