@@ -165,20 +165,34 @@ void require_file_can_be_made(const std::string& file, const std::string& what) 
   fs::remove(probe, ec);
 }
 
+std::vector<fs::path> make_folders_for(const fs::path& file) {
+  const fs::path dir = file.parent_path();
+  const std::vector<fs::path> made = folders_to_make(dir);
+  std::error_code ec;
+  if (made.empty() && !dir.empty() && !fs::is_directory(dir, ec)) throw write_error(file.string(), ENOTDIR);
+  if (!made.empty() && (fs::create_directories(dir, ec), ec)) {
+    const int error = ec.value();
+    remove_made_folders(made);
+    throw write_error(file.string(), error);
+  }
+  return made;
+}
+
+void remove_made_folders(const std::vector<fs::path>& made) {
+  std::error_code ec;
+  for (const fs::path& p : made) {
+    if (!fs::exists(p, ec)) continue;  // not made: making the folders stopped above it
+    if (!fs::is_empty(p, ec) || !fs::remove(p, ec)) return;
+  }
+}
+
 void write_atomically(const fs::path& file, const std::string& text) {
   auto write = [&](const fs::path& to) { write_file(to.string(), [&](std::ostream& out) { out << text; }, true); };
   std::error_code ec;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec)) return write(file);  // a pipe, a device: written to
   const fs::path tmp = temporary(file);
-  const std::vector<fs::path> made = folders_to_make(file.parent_path());
-  auto unmake = [&] {  // the folders made for it, the deepest first
-    for (const fs::path& f : made) fs::remove(f, ec);
-  };
-  if (!made.empty() && (fs::create_directories(file.parent_path(), ec), ec)) {
-    const int error = ec.value();
-    unmake();
-    throw write_error(file.string(), error);
-  }
+  const std::vector<fs::path> made = make_folders_for(file);
+  auto unmake = [&] { remove_made_folders(made); };
   try {
     write(tmp);
   } catch (const std::runtime_error& e) {  // named as the file asked for
@@ -296,30 +310,22 @@ OutputDir::OutputDir(const fs::path& dir, std::vector<std::string> outputs, cons
   created_ = folders_to_make(dir_);
   fs::create_directories(dir_, ec);
   if (ec) {
-    remove_created();
+    remove_made_folders(created_);
     throw std::invalid_argument("cannot create output folder '" + dir_.string() + "': " + ec.message());
   }
   reclaim_temporaries(dir_);
   staging_ = dir_ / (std::string(kStagingTag) + std::to_string(::getpid()));
   fs::create_directory(staging_, ec);
   if (ec) {
-    remove_created();
+    remove_made_folders(created_);
     throw std::invalid_argument("cannot write into output folder '" + dir_.string() + "': " + ec.message());
-  }
-}
-
-void OutputDir::remove_created() const {
-  std::error_code ec;
-  for (const fs::path& p : created_) {
-    if (!fs::exists(p, ec)) continue;  // not made: creating the folders stopped above it
-    if (!fs::is_empty(p, ec) || !fs::remove(p, ec)) return;
   }
 }
 
 OutputDir::~OutputDir() {
   std::error_code ec;
   if (!keep_staging_) fs::remove_all(staging_, ec);
-  remove_created();
+  remove_made_folders(created_);
 }
 
 void OutputDir::commit(const std::function<void(const fs::path&)>& moved) {

@@ -59,6 +59,12 @@ std::filesystem::path temporary(const std::filesystem::path& name);
 // once written (on a failure the temporary is removed and write_error's words thrown, naming
 // `file`). A file there that is no regular file (a pipe, a device) is written to as it is.
 void write_atomically(const std::filesystem::path& file, const std::string& text);
+// Makes the folder that is to hold `file`; returns the folders it made, the deepest first, for
+// remove_made_folders. Throws write_error's words, naming `file`, where one cannot be made.
+std::vector<std::filesystem::path> make_folders_for(const std::filesystem::path& file);
+// Removes those of `made` (make_folders_for's) that are empty, from the deepest up to one that
+// is not.
+void remove_made_folders(const std::vector<std::filesystem::path>& made);
 // Whether `name` is a temporary's.
 bool is_temporary(const std::string& name);
 // Removes the temporaries and staging folders in `dir` whose process is gone.
@@ -107,7 +113,6 @@ class OutputDir {
   std::vector<std::string> outputs_;
   std::set<std::string> earlier_;  // of `outputs_`, those the folder's earlier run wrote
   std::vector<std::filesystem::path> created_;  // the folders the constructor made, the deepest first
-  void remove_created() const;  // those of them that are empty, from the deepest up to one that is not
 };
 
 // Binary little-endian PLY: vertex x y z vx vy vz (float); cloth grids also get their

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "experiments/output.hpp"
+
 namespace deformlab::viewer {
 namespace {
 
@@ -23,10 +25,11 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
     : file_(std::move(file)), partial_(file_ + ".partial-" + std::to_string(getpid())), w_(width), h_(height) {
   if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
     throw std::invalid_argument("recording needs ffmpeg, which is not installed");
-  std::error_code ec;
-  if (const auto dir = std::filesystem::path(file_).parent_path(); !dir.empty())
-    if (std::filesystem::create_directories(dir, ec); ec)
-      throw std::invalid_argument("cannot record into " + file_ + ": " + ec.message());
+  try {
+    made_ = make_folders_for(file_);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(std::string("cannot record: ") + e.what());
+  }
   std::signal(SIGPIPE, SIG_IGN);  // a failed ffmpeg shows as a write error, not a dead viewer
   // H.264 in yuv420p wants even sizes: an odd last row or column is cut. In a session of its
   // own (setsid), so that a terminal's Ctrl-C reaches the viewer, which finishes the recording,
@@ -38,13 +41,18 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
                           " -i - -vf 'vflip,crop=trunc(iw/2)*2:trunc(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -f mp4 " +
                           shell_quoted(partial_);
   pipe_ = popen(cmd.c_str(), "w");
-  if (!pipe_) throw std::runtime_error("cannot start ffmpeg");
+  if (!pipe_) {
+    remove_made_folders(made_);
+    throw std::runtime_error("cannot start ffmpeg");
+  }
 }
 
 Recorder::~Recorder() {
   if (!pipe_) return;
   pclose(pipe_);
-  std::filesystem::remove(partial_);
+  std::error_code ec;
+  std::filesystem::remove(partial_, ec);
+  remove_made_folders(made_);
 }
 
 void Recorder::add(const std::vector<std::uint8_t>& rgba) {
@@ -58,7 +66,9 @@ void Recorder::add(const std::vector<std::uint8_t>& rgba) {
 void Recorder::finish() {
   const int status = pclose(std::exchange(pipe_, nullptr));
   if (status != 0 || frames_ == 0) {
-    std::filesystem::remove(partial_);
+    std::error_code ec;
+    std::filesystem::remove(partial_, ec);
+    remove_made_folders(made_);
     throw std::runtime_error("ffmpeg could not write " + file_);
   }
   std::filesystem::rename(partial_, file_);

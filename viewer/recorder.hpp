@@ -1,9 +1,10 @@
 // An MP4 written as the frames come: RGBA frames piped to ffmpeg (H.264, yuv420p, 30 frames
 // per second). The file appears under its name only once finished: until then ffmpeg writes
-// FILE.partial-PID, removed if the recording fails.
+// FILE.partial-PID, removed if the recording fails, with the folders made for it.
 #pragma once
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -11,7 +12,8 @@ namespace deformlab::viewer {
 
 class Recorder {
  public:
-  // Throws std::invalid_argument when ffmpeg is not installed or the folder does not exist.
+  // Makes the file's folder; throws std::invalid_argument when ffmpeg is not installed or the
+  // folder cannot be made.
   Recorder(std::string file, int width, int height, int fps = 30);
   ~Recorder();  // a recording never finished is removed
   Recorder(const Recorder&) = delete;
@@ -28,6 +30,7 @@ class Recorder {
 
  private:
   std::string file_, partial_;
+  std::vector<std::filesystem::path> made_;  // the folders made for the file, the deepest first
   int w_, h_, frames_ = 0;
   FILE* pipe_ = nullptr;
 };
