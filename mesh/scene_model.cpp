@@ -239,8 +239,9 @@ float grid_spacing(const ModelSpec& m) {
     throw std::invalid_argument(os.str());
   }
   // The farthest coordinate as cloth_grid and lattice place the nodes (centred in x and z, from
-  // `height` up in y), to the bit; the shortest spring is the structural one, h.
-  const float cx = 0.5f * float(m.nx - 1) * h, cz = 0.5f * float((m.topology == Topology::lattice ? m.nz : m.ny) - 1) * h;
+  // `height` up in y), by the same float expressions; the shortest spring is the structural one, h.
+  const int along_z = m.topology == Topology::lattice ? m.nz : m.ny;
+  const float cx = 0.5f * float(m.nx - 1) * h, cz = 0.5f * float(along_z - 1) * h;
   const float top = m.topology == Topology::lattice ? m.height + float(m.ny - 1) * h : m.height;
   require_float_resolution(std::max({cx, cz, std::abs(m.height), std::abs(top)}), h, "");
   return h;
