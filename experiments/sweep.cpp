@@ -89,13 +89,14 @@ std::optional<Sweep> parse_sweep(const json& x, const std::string& where) {
     if (k == "sizes") {
       if (!v.is_array() || v.empty()) bad_value(w + ".sizes", "expected a non-empty list of sizes");
       for (const auto& n : v) {
-        s.sizes.push_back(positive(n, w + ".sizes"));
+        const std::string at = w + ".sizes[" + std::to_string(s.sizes.size()) + "]";
+        s.sizes.push_back(positive(n, at));
         if (std::count(s.sizes.begin(), s.sizes.end(), s.sizes.back()) > 1)
-          bad_value(w + ".sizes", "size " + std::to_string(s.sizes.back()) + " is named twice");
+          bad_value(at, "size " + std::to_string(s.sizes.back()) + " is named twice");
         try {
           check_node_count(std::pow(double(s.sizes.back()), s.lattice ? 3 : 2));
         } catch (const std::invalid_argument& e) {
-          bad_value(w + ".sizes", "size " + size_label(s.sizes.back(), s.lattice) + ": " + e.what());
+          bad_value(at, "size " + size_label(s.sizes.back(), s.lattice) + ": " + e.what());
         }
       }
     } else if (k == "models") s.models = parse_sweep_models(v, w + ".models");
@@ -235,13 +236,33 @@ std::string size_key(const Sweep& s, int size) {
   return s.where + ".sweep.sizes[" + std::to_string(k) + "]: size " + size_label(size, s.lattice);
 }
 
-void require_size_scenes(const Experiment& x, const Sweep& s) {
+void require_size_grids(const Experiment& x, const Sweep& s) {
+  if (x.scene.model.topology == Topology::general) return;
   for (const int n : s.sizes) {
     Scene scene = x.scene;
     size_model(scene.model, n);
     try {
-      if (scene.model.topology != Topology::general) grid_spacing(scene.model);  // any size: built from the spec
-      if (model_size(scene.model).nodes <= kCheckedNodes) resolve_params(scene, build_model(scene));
+      grid_spacing(scene.model);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(size_key(s, n) + ": " + e.what());
+    }
+  }
+  if (s.frames == 0) return;
+  try {
+    grid_spacing(x.scene.model);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(s.where + ".scene.model (" + describe(x.scene.model) +
+                                ", the experiment's own scene, whose frames its sweep draws): " + e.what());
+  }
+}
+
+void require_size_scenes(const Experiment& x, const Sweep& s) {
+  for (const int n : s.sizes) {
+    Scene scene = x.scene;
+    size_model(scene.model, n);
+    if (model_size(scene.model).nodes > kCheckedNodes) continue;
+    try {
+      resolve_params(scene, build_model(scene));
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(size_key(s, n) + ": " + e.what());
     }

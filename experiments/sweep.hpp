@@ -63,10 +63,13 @@ std::string size_label(int n, bool lattice);
 void size_model(ModelSpec& ms, int n);
 
 std::optional<Sweep> parse_sweep(const nlohmann::json& experiment, const std::string& where);
+// Throws std::invalid_argument naming the first grid size whose spacing or float resolution is
+// bad input (grid_spacing, from the spec: no model built), or the experiment's own scene where
+// the sweep draws its frames; for every size, before the sizes are cut to --max-size.
+void require_size_grids(const Experiment& x, const Sweep& s);
 // Throws std::invalid_argument naming the first grid size on which the experiment's scene is bad
-// input, before the first cell: on every size its spacing and float resolution (grid_spacing), and
-// on every size of up to kCheckedNodes nodes (built for it) its pins, drag node and colliders
-// (a pin or drag node outside or on each other, a node deep in a collider: resolve_params).
+// input (a pin or drag node outside or on each other, a node deep in a collider: resolve_params),
+// checked before the first cell on every size of up to kCheckedNodes nodes (built for it).
 constexpr std::int64_t kCheckedNodes = std::int64_t(1) << 22;
 void require_size_scenes(const Experiment& x, const Sweep& s);
 // The key path of a grid size, for errors: "x.json.sweep.sizes[k]: size 64²".

@@ -453,6 +453,16 @@ const std::vector<BadInput>& cases() {
        "x.json.sweep.sizes[1]: size 4096²: it lies up to 40 m from the origin, where floats are 3.81e-06 m apart: more "
        "than a hundredth of its shortest spring (0.000244 m)",
        {{"x.json", R"({"base": "quick", "scene": {"model": {"height": 40}}, "sweep": {"sizes": [8, 4096], "pipelines": ["cpu"]}})"}}},
+      {"sweep_size_float_resolution_past_max_size", "experiment {dir}/x.json --max-size 8",
+       "x.json.sweep.sizes[1]: size 4096²: it lies up to 40 m from the origin",
+       {{"x.json", R"({"base": "quick", "scene": {"model": {"height": 40}}, "sweep": {"sizes": [8, 4096], "pipelines": ["cpu"]}})"}}},
+      // The frames' 128² cloth at 1500 m is refused; the 16² cells alone would hold there.
+      {"sweep_frames_scene_float_resolution", "experiment {dir}/x.json",
+       "x.json.scene.model (cloth 128x128, the experiment's own scene, whose frames its sweep draws): it lies up to 1.5e+03 m",
+       {{"x.json", R"({"base": "quick", "scene": {"model": {"height": 1500}}, "sweep": {"sizes": [16], "pipelines": ["cpu"]}})"}}},
+      {"sweep_size_past_the_node_limit", "experiment {dir}/x.json",
+       "x.json.sweep.sizes[1]: size 32769²: a model of about",
+       {{"x.json", R"({"base": "quick", "sweep": {"sizes": [16, 32769], "pipelines": ["cpu"]}})"}}},
       {"sweep_size_drag_node_pinned", "experiment {dir}/x.json",
        "x.json.sweep.sizes[0]: size 1²: built-in paper-drag.json.scene.drag.node: node 0 is pinned (model.pins)",
        {{"x.json", R"({"base": "quick", "sweep": {"sizes": [1, 8], "pipelines": ["cpu"]}})"}}},

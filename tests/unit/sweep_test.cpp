@@ -343,7 +343,7 @@ TEST_F(SweepTest, LatticeSweepsCountAndLabelTheirSizesCubed) {
     parse_sweep(big.raw, "big.json");
     ADD_FAILURE() << "a lattice sweep past 2^30 nodes was taken";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("big.json.sweep.sizes: size 1025³: a model of about"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("big.json.sweep.sizes[1]: size 1025³: a model of about"), std::string::npos)
         << e.what();
   }
   EXPECT_FALSE(parse_sweep(tiny(R"({"sizes": [1025], "pipelines": ["cpu"]})").raw, "tiny")->lattice);
@@ -380,6 +380,7 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
     EXPECT_EQ(swept.count(n), std::size_t(x.raw.contains("sweep"))) << n;
     EXPECT_NO_THROW(parse_sweep(x.raw, n)) << n << ": its sweep reads";
     if (const auto s = parse_sweep(x.raw, n)) {
+      EXPECT_NO_THROW(require_size_grids(x, *s)) << n << ": its grids hold at each size";
       EXPECT_NO_THROW(require_size_scenes(x, *s)) << n << ": its scene holds at each size";
     }
   }
@@ -460,8 +461,8 @@ TEST_F(SweepTest, BadSweepsAreNamed) {
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["warp"]})").find("unknown pipeline 'warp'"), std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu"], "integrators": ["leap"]})").find("unknown integrator"),
             std::string::npos);
-  EXPECT_NE(error(R"({"sizes": [0], "pipelines": ["cpu"]})").find("sweep.sizes"), std::string::npos);
-  EXPECT_NE(error(R"({"sizes": [4, 8, 4], "pipelines": ["cpu"]})").find("sweep.sizes: size 4 is named twice"),
+  EXPECT_NE(error(R"({"sizes": [4, 0], "pipelines": ["cpu"]})").find("sweep.sizes[1]: expected"), std::string::npos);
+  EXPECT_NE(error(R"({"sizes": [4, 8, 4], "pipelines": ["cpu"]})").find("sweep.sizes[2]: size 4 is named twice"),
             std::string::npos);
   EXPECT_NE(error(R"({"sizes": [4], "pipelines": ["cpu", "cpu"]})").find("sweep.pipelines: 'cpu' is named twice"),
             std::string::npos);
