@@ -352,10 +352,18 @@ int run_command(const RunArgs& a) {
         a.compare ? unless_interrupted([&] { return compare_with_reference(in, final_state, r.steps); }) : json();
     const StepMedians med = medians_of(r, profiler);
 
+    // A signal while the outputs are written (state.ply can take minutes) stops before the next
+    // one, and the folder is left as it was.
+    auto unless_signalled = [](const char* next) {
+      if (const int sig = InterruptCatcher::caught())
+        throw Interrupted(sig, signal_name(sig) + " before writing " + next + ": the run stopped and wrote nothing");
+    };
     write_timings_csv(dir.staged("timings.csv"), r);
     if (a.energy) write_energy_csv(dir.staged("energy.csv"), ran.energy);
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
+    unless_signalled("state.ply");
     if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
+    unless_signalled("manifest.json");
     json manifest = manifest_of(a, in, *pipe, ran, profiler, med, setup_s);
     if (a.compare) manifest["compare"] = compare;
 #if DEFORMLAB_GL_RENDER

@@ -109,6 +109,31 @@ TEST_F(Cli, InterruptedRunSaysSoAndLeavesTheFolderAsItWas) {
   EXPECT_FALSE(fs::exists(fresh));
 }
 
+// A signal while a run writes its outputs (here: once its timings are staged, before or while
+// its 200 MB state.ply is written) stops it before its folder changes.
+TEST_F(Cli, RunInterruptedWhileWritingLeavesTheFolderAsItWas) {
+  const fs::path out = dir_ / "run", err = dir_ / "err.txt";
+  ASSERT_EQ(run("run --pipeline cpu --grid 8x6 --steps 10 --out " + out.string()).code, 0);
+  const auto before = files_of(out);
+  auto timings_staged = [&] {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(out, ec))
+      if (e.path().filename().string().rfind(".deformlab-staging-", 0) == 0 && fs::exists(e.path() / "timings.csv"))
+        return true;
+    return false;
+  };
+  int status = 0;
+  ASSERT_TRUE(signal_when("run --pipeline omp --grid 2048x2048 --steps 2 --out " + out.string(), timings_staged,
+                          SIGTERM, status, err))
+      << "the run ended before its timings were staged";
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by the signal itself";
+  const std::string text = slurp(err);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << text;
+  EXPECT_NE(text.find("deformlab: error: SIGTERM before writing "), std::string::npos) << text;
+  EXPECT_NE(text.find(": the run stopped and wrote nothing\n"), std::string::npos) << text;
+  EXPECT_EQ(files_of(out), before);
+}
+
 // A sweep stops between cells: those done are kept, and running it again measures the rest.
 TEST_F(Cli, InterruptedSweepKeepsItsCells) {
   // About 4 s of cells on a 2-core machine: still running at the signal on a fast one.
