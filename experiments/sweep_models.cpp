@@ -95,7 +95,12 @@ void require_model_files(const Experiment& x, const Sweep& s) {
     if (!file.empty() && !std::filesystem::is_regular_file(file, ec))
       bad_value(w + ".file", "'" + file + "': " +
                                  (ec && ec != std::errc::no_such_file_or_directory ? ec.message() : "no such file"));
-    check_mesh_file(scene);  // its errors name the file, or the key (pins, the drag node)
+    try {
+      check_mesh_file(scene);  // its errors name the file, or the key (pins, the drag node)
+    } catch (const std::invalid_argument& e) {
+      if (!scene.model.mesh.generate) throw;
+      throw std::invalid_argument(at + ": " + e.what());  // a generated shape placed where floats cannot hold it
+    }
   }
 }
 

@@ -51,19 +51,6 @@ void check_memory(const Mesh& mesh) {
                std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()));
 }
 
-// The mesh the spec names: read from its file or generated; what names it in errors.
-Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
-  if (ms.generate) {
-    what = "generated " + std::string(to_string(ms.generate->kind));
-    return generated_mesh(*ms.generate);
-  }
-  if (ms.file.empty())
-    throw std::invalid_argument((ms.where.empty() ? "" : ms.where + ": ") +
-                                "a mesh model needs a file (\"file\") or a shape (\"generate\")");
-  what = "mesh file '" + ms.file + "'";
-  return load_mesh(ms.file, notes);
-}
-
 // `e` again, of its kind (DoesNotFit or not), with `what` before its message.
 [[noreturn]] void rethrow_naming(const std::string& what, const std::invalid_argument& e) {
   if (dynamic_cast<const DoesNotFit*>(&e)) throw DoesNotFit(what + ": " + e.what());
@@ -81,6 +68,58 @@ auto naming(const std::string& what, F&& f) {
   } catch (const std::invalid_argument& e) {
     rethrow_naming(what, e);
   }
+}
+
+// Refuses a model whose nodes reach `far` m from the origin along an axis, where float positions
+// are more than a hundredth of its shortest spring (`shortest` m long; `which` names it) apart:
+// its strains and small moves would be lost to rounding (a 16 x 16 cloth at 1e5 m never moved,
+// and its run stopped as converged; at 1e4 m it jittered to max_steps). A 16384^2 cloth 1 m wide
+// at 1 m, the paper's largest, has floats 0.2% of a spring apart.
+void require_float_resolution(float far, float shortest, const std::string& which) {
+  const float step = std::nextafter(far, INFINITY) - far;
+  if (step <= 1e-2f * shortest) return;
+  std::ostringstream os;
+  os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
+     << " m apart: more than a hundredth of its shortest spring (" << shortest << " m" << which
+     << "), so rounding would swallow its strains and small moves: place it nearer the origin, or make that spring "
+        "longer";
+  throw std::invalid_argument(os.str());
+}
+
+// Refuses a generated shape placed where require_float_resolution would refuse it once meshed,
+// before Gmsh meshes it: its farthest corner once scaled and transformed, and as its shortest
+// spring a bound, twice its cell size stretched by the scale and transform's linear part
+// (Frobenius norm: at least its largest stretch; Gmsh's edges stay well within that).
+void require_generated_resolution(const MeshSpec& ms) {
+  const MeshShape& g = *ms.generate;
+  const auto& t = ms.transform;
+  const bool box = g.kind == MeshShape::Kind::box;  // a box stands on y = 0, a sheet lies in it
+  float far = 0.f;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3f p{(c & 1 ? 0.5f : -0.5f) * g.size.x * ms.scale.x, (box && (c & 2) ? g.size.y : 0.f) * ms.scale.y,
+                  (c & 4 ? 0.5f : -0.5f) * g.size.z * ms.scale.z};
+    for (int r = 0; r < 3; ++r)
+      far = std::max(far, std::abs(t[r * 4] * p.x + t[r * 4 + 1] * p.y + t[r * 4 + 2] * p.z + t[r * 4 + 3]));
+  }
+  double stretch = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) stretch += std::pow(double(t[r * 4 + c]) * ms.scale[c], 2);
+  require_float_resolution(far, float(2 * g.cell_size * std::sqrt(stretch)),
+                           " or less: twice its cell_size, scaled and transformed, bounds it");
+}
+
+// The mesh the spec names: read from its file or generated; what names it in errors.
+Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
+  if (ms.generate) {
+    what = "generated " + std::string(to_string(ms.generate->kind));
+    naming(what, [&] { require_generated_resolution(ms); });
+    return generated_mesh(*ms.generate);
+  }
+  if (ms.file.empty())
+    throw std::invalid_argument((ms.where.empty() ? "" : ms.where + ": ") +
+                                "a mesh model needs a file (\"file\") or a shape (\"generate\")");
+  what = "mesh file '" + ms.file + "'";
+  return load_mesh(ms.file, notes);
 }
 
 // Refuses a fill whose tetrahedra of `cell_size` would make more than 2^30 nodes, or a model
@@ -149,22 +188,6 @@ Mesh model_mesh(const MeshSpec& ms, std::vector<std::string>& notes, std::string
   });
 }
 
-// Refuses a model whose nodes reach `far` m from the origin along an axis, where float positions
-// are more than a hundredth of its shortest spring (`shortest` m long; `which` names it) apart:
-// its strains and small moves would be lost to rounding (a 16 x 16 cloth at 1e5 m never moved,
-// and its run stopped as converged; at 1e4 m it jittered to max_steps). A 16384^2 cloth 1 m wide
-// at 1 m, the paper's largest, has floats 0.2% of a spring apart.
-void require_float_resolution(float far, float shortest, const std::string& which) {
-  const float step = std::nextafter(far, INFINITY) - far;
-  if (step <= 1e-2f * shortest) return;
-  std::ostringstream os;
-  os << std::setprecision(3) << "it lies up to " << far << " m from the origin, where floats are " << step
-     << " m apart: more than a hundredth of its shortest spring (" << shortest << " m" << which
-     << "), so rounding would swallow its strains and small moves: place it nearer the origin, or make that spring "
-        "longer";
-  throw std::invalid_argument(os.str());
-}
-
 Model mesh_model_of(const ModelSpec& spec) {
   std::vector<std::string> notes;
   std::string what;
@@ -210,7 +233,11 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
 
 void check_mesh_file(const Scene& s) {
   const MeshSpec& ms = s.model.mesh;
-  if (s.model.topology != Topology::general || ms.generate || ms.file.empty()) return;
+  if (s.model.topology != Topology::general) return;
+  if (ms.generate) return naming("generated " + std::string(to_string(ms.generate->kind)), [&] {
+    require_generated_resolution(ms);
+  });
+  if (ms.file.empty()) return;
   if (ms.fill) {
     std::vector<std::string> notes;
     std::string what;

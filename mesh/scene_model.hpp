@@ -25,9 +25,9 @@ Mesh filled_mesh(const MeshSpec& ms, const std::string& save_to);
 
 // For a scene whose model names a mesh file: reads, places and repairs it and, unless it is to
 // be filled, builds the model with its pins and finds its drag node (a model to be filled:
-// checked up to its fill), so
-// that a damaged file is refused before a sweep's first cell; throws std::invalid_argument
-// naming it.
+// checked up to its fill), so that a damaged file is refused before a sweep's first cell; for
+// a generated shape, whether floats resolve it where it is placed (before Gmsh meshes it).
+// Throws std::invalid_argument naming the file or shape.
 void check_mesh_file(const Scene& s);
 
 // The spacing of a grid or lattice model (from its width where it has none), computed without

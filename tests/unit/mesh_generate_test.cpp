@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -150,6 +151,38 @@ TEST(GeneratedMesh, TakesTheSamePathAsAFile) {
   EXPECT_EQ(to_json(t), to_json(sc));
   EXPECT_EQ(to_json(sc)["model"]["generate"]["size"], json::array({0.1, 0.1, 0.1}));  // as the file gave it
   EXPECT_EQ(to_json(sc)["model"]["generate"]["threads"], 1);
+}
+
+// A generated shape is refused before meshing where floats could not hold it, its shortest
+// spring bounded by twice its cell size (scaled and transformed); the bound holds on the meshes
+// Gmsh makes, so no shape the model's own rule would take is refused.
+TEST(GeneratedMesh, FarShapesAreRefusedBeforeMeshingByABoundTheirSpringsKeep) {
+  for (const auto& [kind, size, h] : {std::tuple{MeshShape::Kind::sheet, Vec3f{0.5f, 0.f, 0.3f}, 0.01f},
+                                      {MeshShape::Kind::sheet, Vec3f{4.f, 0.f, 0.02f}, 0.001f},
+                                      {MeshShape::Kind::box, Vec3f{0.2f, 0.1f, 0.3f}, 0.01f},
+                                      {MeshShape::Kind::box, Vec3f{0.1f, 0.1f, 0.1f}, 0.05f}}) {
+    Mesh mesh = generate_shape(shape(kind, size, h));
+    repair(mesh);
+    const Model m = mesh_model(mesh, Material{}, 1000.f);
+    EXPECT_LE(*std::min_element(m.rest_length.begin(), m.rest_length.end()), 2 * h) << size.x << " " << h;
+  }
+  Scene sc;
+  apply_json(sc, json::parse(R"({"model": {"type": "mesh", "pins": "none",
+      "generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.01}, "scale": 2,
+      "transform": {"translate": [0, 10000, 0]}}})"), "s");
+  try {
+    check_mesh_file(sc);
+    ADD_FAILURE() << "a sheet at 1e4 m was taken";
+  } catch (const std::invalid_argument& e) {
+    // 2 x 0.01 m cells, doubled by the scale, stretched by sqrt(3) (the Frobenius norm's bound).
+    EXPECT_NE(std::string(e.what()).find("generated sheet: it lies up to 1e+04 m from the origin, where floats are "
+                                         "0.000977 m apart: more than a hundredth of its shortest spring (0.0693 m "
+                                         "or less"),
+              std::string::npos)
+        << e.what();
+  }
+  apply_json(sc, json::parse(R"({"model": {"transform": {"translate": [0, 3000, 0]}}})"), "s");
+  EXPECT_NO_THROW(check_mesh_file(sc)) << "at 3000 m floats are 0.000244 m apart";
 }
 
 }  // namespace

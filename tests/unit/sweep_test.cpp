@@ -14,6 +14,7 @@
 #include "experiments/report_parts.hpp"
 #include "experiments/sweep.hpp"
 #include "experiments/sweep_folder.hpp"
+#include "experiments/sweep_models.hpp"
 #include "sweep_support.hpp"
 #include "tests/support/gpu_required.hpp"
 
@@ -382,6 +383,7 @@ TEST(BuiltinExperiments, AreTheTreesExperimentFilesByName) {
     if (const auto s = parse_sweep(x.raw, n)) {
       EXPECT_NO_THROW(require_size_grids(x, *s)) << n << ": its grids hold at each size";
       EXPECT_NO_THROW(require_size_scenes(x, *s)) << n << ": its scene holds at each size";
+      EXPECT_NO_THROW(require_model_files(x, *s)) << n << ": its mesh models read, and floats hold its shapes";
     }
   }
   EXPECT_EQ(swept.count("paper-drag"), 0u);
