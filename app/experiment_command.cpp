@@ -44,7 +44,7 @@ int experiment_command(const ExperimentArgs& a) {
       throw std::invalid_argument(a.file + ".sweep.sizes: the scene's model is a mesh, whose file or \"generate\" gives its size (sweep \"models\")");
     if (a.max_size && !sweep->models.empty()) throw std::invalid_argument("--max-size: this sweep has models, not grid sizes");
     if (a.max_size && a.report_only) throw std::invalid_argument("--max-size limits the cells a run measures; --report-only measures none");
-    require_size_grids(x, *sweep);
+    if (!a.report_only) require_size_grids(x, *sweep);  // a report is written of the cells there are
     if (a.max_size) {
       std::erase_if(sweep->sizes, [&](int n) { return n > *a.max_size; });
       if (sweep->sizes.empty()) throw std::invalid_argument("--max-size leaves no grid size to run");

@@ -361,7 +361,7 @@ int run_command(const RunArgs& a) {
     write_timings_csv(dir.staged("timings.csv"), r);
     if (a.energy) write_energy_csv(dir.staged("energy.csv"), ran.energy);
     if (a.trace) profiler.write_trace(dir.staged("trace.json").string());
-    unless_signalled("state.ply");
+    unless_signalled(a.no_state ? "manifest.json" : "state.ply");
     if (!a.no_state) write_ply(dir.staged("state.ply"), in.model, final_state);
     unless_signalled("manifest.json");
     json manifest = manifest_of(a, in, *pipe, ran, profiler, med, setup_s);

@@ -169,7 +169,7 @@ std::vector<fs::path> make_folders_for(const fs::path& file) {
   const fs::path dir = file.parent_path();
   const std::vector<fs::path> made = folders_to_make(dir);
   std::error_code ec;
-  if (made.empty() && !dir.empty() && !fs::is_directory(dir, ec)) throw write_error(file.string(), ENOTDIR);
+  if (made.empty() && !dir.empty() && !fs::is_directory(dir, ec)) throw write_error(file.string(), ec ? ec.value() : ENOTDIR);
   if (!made.empty() && (fs::create_directories(dir, ec), ec)) {
     const int error = ec.value();
     remove_made_folders(made);

@@ -19,8 +19,9 @@ std::vector<std::string> parse_sweep_orders(const nlohmann::json& j, const std::
 void check_models_under_orders(const Sweep& s, const std::string& where);
 
 // Throws std::invalid_argument naming the first model whose mesh file is missing or cannot be
-// read and repaired (check_mesh_file; relative files from the experiment's folder): checked
-// before the first cell runs. A model generated or filled is checked at its first cell.
+// read and repaired, or whose generated shape floats cannot hold where it is placed
+// (check_mesh_file; relative files from the experiment's folder): checked before the first cell
+// runs. A model generated or filled is meshed, and its model checked, at its first cell.
 void require_model_files(const Experiment& x, const Sweep& s);
 
 // The key path of the sweep's model k, or of the model named so, for errors:

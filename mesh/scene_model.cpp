@@ -51,6 +51,8 @@ void check_memory(const Mesh& mesh) {
                std::int64_t(mesh.triangle.size() + mesh.tetrahedron.size()));
 }
 
+std::string generated_name(MeshShape::Kind k) { return "generated " + std::string(to_string(k)); }
+
 // `e` again, of its kind (DoesNotFit or not), with `what` before its message.
 [[noreturn]] void rethrow_naming(const std::string& what, const std::invalid_argument& e) {
   if (dynamic_cast<const DoesNotFit*>(&e)) throw DoesNotFit(what + ": " + e.what());
@@ -101,6 +103,7 @@ void require_generated_resolution(const MeshSpec& ms) {
     for (int r = 0; r < 3; ++r)
       far = std::max(far, std::abs(t[r * 4] * p.x + t[r * 4 + 1] * p.y + t[r * 4 + 2] * p.z + t[r * 4 + 3]));
   }
+  if (!(far <= kFarthest)) return;  // place() refuses it, saying why
   double stretch = 0;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) stretch += std::pow(double(t[r * 4 + c]) * ms.scale[c], 2);
@@ -111,7 +114,7 @@ void require_generated_resolution(const MeshSpec& ms) {
 // The mesh the spec names: read from its file or generated; what names it in errors.
 Mesh source_mesh(const MeshSpec& ms, std::string& what, std::vector<std::string>& notes) {
   if (ms.generate) {
-    what = "generated " + std::string(to_string(ms.generate->kind));
+    what = generated_name(ms.generate->kind);
     naming(what, [&] { require_generated_resolution(ms); });
     return generated_mesh(*ms.generate);
   }
@@ -226,7 +229,7 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
   try {
     check_memory(std::int64_t(n), std::int64_t(n * (sheet ? 6.5 : 16)), std::int64_t(n * (sheet ? 2.2 : 6.6)));
   } catch (const std::invalid_argument& e) {
-    rethrow_naming("generated " + std::string(to_string(shape.kind)) + " of " + about_nodes(n), e);
+    rethrow_naming(generated_name(shape.kind) + " of " + about_nodes(n), e);
   }
   return generate_shape(shape, save_to);
 }
@@ -234,7 +237,7 @@ Mesh generated_mesh(const MeshShape& shape, const std::string& save_to) {
 void check_mesh_file(const Scene& s) {
   const MeshSpec& ms = s.model.mesh;
   if (s.model.topology != Topology::general) return;
-  if (ms.generate) return naming("generated " + std::string(to_string(ms.generate->kind)), [&] {
+  if (ms.generate) return naming(generated_name(ms.generate->kind), [&] {
     require_generated_resolution(ms);
   });
   if (ms.file.empty()) return;

@@ -71,7 +71,12 @@ void Recorder::finish() {
     remove_made_folders(made_);
     throw std::runtime_error("ffmpeg could not write " + file_);
   }
-  std::filesystem::rename(partial_, file_);
+  std::error_code ec;
+  if (std::filesystem::rename(partial_, file_, ec); ec) {
+    std::filesystem::remove(partial_, ec);
+    remove_made_folders(made_);
+    throw std::runtime_error("cannot move the recording into " + file_ + ": " + ec.message());
+  }
 }
 
 }  // namespace deformlab::viewer

@@ -10,6 +10,26 @@
 namespace deformlab::test {
 namespace {
 
+// A size that floats cannot hold is refused before a run's first cell, but a report is still
+// written of the cells there are.
+TEST_F(Cli, AReportIsWrittenThoughASizeNotRunIsBad) {
+  const std::string scene = R"("scene": {"model": {"size": [4, 4], "height": 40}, "drag": null})";
+  write("x.json", R"({"name": "tiny", )" + scene + R"(, "sweep": {"sizes": [4], "pipelines": ["cpu"], "warmup": 2,
+                      "steps": 2, "repetitions": 2, "frames": 0}})");
+  const std::string experiment = "experiment " + (dir_ / "x.json").string() + " --out " + (dir_ / "r").string();
+  ASSERT_EQ(run(experiment).code, 0);
+  write("x.json", R"({"name": "tiny", )" + scene + R"(, "sweep": {"sizes": [4, 4096], "pipelines": ["cpu"],
+                      "warmup": 2, "steps": 2, "repetitions": 2, "frames": 0}})");
+  const Result refused = run(experiment);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("x.json.sweep.sizes[1]: size 4096²: it lies up to 40 m from the origin"), std::string::npos)
+      << refused.err;
+  const Result report = run(experiment + " --report-only");
+  EXPECT_EQ(report.code, 0) << report.err;
+  const std::string md = slurp(dir_ / "r" / "report.md");
+  EXPECT_NE(md.find("| 4² |"), std::string::npos) << md;
+}
+
 // A results folder whose files were damaged or edited: a cell whose values are of other kinds
 // is named (and measured again by a run); a manifest so is one line too.
 TEST_F(Cli, DamagedResultsAreNamedWithOneLine) {

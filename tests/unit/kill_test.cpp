@@ -110,7 +110,8 @@ TEST_F(Cli, InterruptedRunSaysSoAndLeavesTheFolderAsItWas) {
 }
 
 // A signal while a run writes its outputs (here: once its timings are staged, before or while
-// its 200 MB state.ply is written) stops it before its folder changes.
+// its 200 MB state.ply is written, which takes the run a second or more) stops it before its
+// folder changes. The omp pipeline's 2048² model and state take about 1 GB.
 TEST_F(Cli, RunInterruptedWhileWritingLeavesTheFolderAsItWas) {
   const fs::path out = dir_ / "run", err = dir_ / "err.txt";
   ASSERT_EQ(run("run --pipeline cpu --grid 8x6 --steps 10 --out " + out.string()).code, 0);
@@ -131,6 +132,7 @@ TEST_F(Cli, RunInterruptedWhileWritingLeavesTheFolderAsItWas) {
   EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << text;
   EXPECT_NE(text.find("deformlab: error: SIGTERM before writing "), std::string::npos) << text;
   EXPECT_NE(text.find(": the run stopped and wrote nothing\n"), std::string::npos) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
   EXPECT_EQ(files_of(out), before);
 }
 

@@ -183,6 +183,17 @@ TEST(GeneratedMesh, FarShapesAreRefusedBeforeMeshingByABoundTheirSpringsKeep) {
   }
   apply_json(sc, json::parse(R"({"model": {"transform": {"translate": [0, 3000, 0]}}})"), "s");
   EXPECT_NO_THROW(check_mesh_file(sc)) << "at 3000 m floats are 0.000244 m apart";
+  // Past 1e15 m the placing refuses it, saying why (squared lengths overflow), once meshed.
+  apply_json(sc, json::parse(R"({"model": {"generate": {"shape": "sheet", "size": [1, 1], "cell_size": 0.25},
+      "transform": {"translate": [0, 1e16, 0]}}})"), "s");
+  EXPECT_NO_THROW(check_mesh_file(sc));
+  try {
+    build_model(sc);
+    ADD_FAILURE() << "a sheet at 1e16 m was built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("more than 1e15 m from the origin along an axis"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
