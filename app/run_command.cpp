@@ -355,8 +355,10 @@ int run_command(const RunArgs& a) {
     // A signal while the outputs are written (state.ply can take minutes) stops before the next
     // one, and the folder is left as it was.
     auto unless_signalled = [](const char* next) {
-      if (const int sig = InterruptCatcher::caught())
-        throw Interrupted(sig, signal_name(sig) + " before writing " + next + ": the run stopped and wrote nothing");
+      unless_interrupted([&] {
+        if (const int sig = InterruptCatcher::caught())
+          throw Interrupted(sig, signal_name(sig) + " before writing " + next);
+      });
     };
     write_timings_csv(dir.staged("timings.csv"), r);
     if (a.energy) write_energy_csv(dir.staged("energy.csv"), ran.energy);

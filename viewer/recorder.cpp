@@ -42,7 +42,7 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
                           shell_quoted(partial_);
   pipe_ = popen(cmd.c_str(), "w");
   if (!pipe_) {
-    remove_made_folders(made_);
+    discard();
     throw std::runtime_error("cannot start ffmpeg");
   }
 }
@@ -50,6 +50,10 @@ Recorder::Recorder(std::string file, int width, int height, int fps)
 Recorder::~Recorder() {
   if (!pipe_) return;
   pclose(pipe_);
+  discard();
+}
+
+void Recorder::discard() const {
   std::error_code ec;
   std::filesystem::remove(partial_, ec);
   remove_made_folders(made_);
@@ -66,15 +70,12 @@ void Recorder::add(const std::vector<std::uint8_t>& rgba) {
 void Recorder::finish() {
   const int status = pclose(std::exchange(pipe_, nullptr));
   if (status != 0 || frames_ == 0) {
-    std::error_code ec;
-    std::filesystem::remove(partial_, ec);
-    remove_made_folders(made_);
+    discard();
     throw std::runtime_error("ffmpeg could not write " + file_);
   }
   std::error_code ec;
   if (std::filesystem::rename(partial_, file_, ec); ec) {
-    std::filesystem::remove(partial_, ec);
-    remove_made_folders(made_);
+    discard();
     throw std::runtime_error("cannot move the recording into " + file_ + ": " + ec.message());
   }
 }

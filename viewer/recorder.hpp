@@ -31,6 +31,7 @@ class Recorder {
  private:
   std::string file_, partial_;
   std::vector<std::filesystem::path> made_;  // the folders made for the file, the deepest first
+  void discard() const;  // removes the partial file and the folders made for it
   int w_, h_, frames_ = 0;
   FILE* pipe_ = nullptr;
 };
